@@ -1,0 +1,338 @@
+#include "rff_ceres/io/dataset_io.h"
+
+#include <algorithm>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+
+#include "rff_ceres/io/text_parser.h"
+
+namespace rff {
+namespace {
+
+// Numbers of fields after the record name, per record type.
+const std::map<std::string_view, std::size_t>& RecordArity() {
+  static const auto* const arity = new std::map<std::string_view, std::size_t>{
+      {"RFFD", 1},          {"PRIOR_POSE", 6}, {"PRIOR_LANDMARK", 4},
+      {"ODOM", 8},          {"RANGE", 4},      {"BEARING", 4},
+      {"RANGE_BEARING", 6}, {"GT_POSE", 4},    {"GT_LANDMARK", 3}};
+  return *arity;
+}
+
+// Parses one .rffd record at a time into a Dataset, with every check of the
+// format: field counts, finite numbers, positive sigmas, t1 > t0, ids.
+class DatasetParser {
+ public:
+  DatasetParser(LineReader* reader, Dataset* dataset)
+      : reader_(*reader), dataset_(dataset) {}
+
+  bool ParseRecord(const std::vector<std::string_view>& fields,
+                   std::string* error) {
+    error_ = error;
+    const std::string_view name = fields[0];
+    const auto it = RecordArity().find(name);
+    if (it == RecordArity().end()) {
+      return Fail("unknown record '" + std::string(name.substr(0, 64)) + "'");
+    }
+    if (fields.size() - 1 != it->second) {
+      return Fail(std::string(name) + " needs " + std::to_string(it->second) +
+                  " fields, got " + std::to_string(fields.size() - 1));
+    }
+    if (!seen_header_ && name != "RFFD") {
+      return Fail("missing header: the first record must be 'RFFD 1', got '" +
+                  std::string(name) + "'");
+    }
+    if (name == "RFFD") return ParseHeader(fields);
+    // The id, where a record has one, is the field after the time (or the
+    // first field for landmark records); everything else is a double.
+    if (name == "PRIOR_LANDMARK" || name == "GT_LANDMARK") {
+      LandmarkId id;
+      if (!ParseId(fields[1], &id)) return false;
+      double v[3];
+      if (!Numbers(fields, 2, fields.size() - 2, v)) return false;
+      return name == "PRIOR_LANDMARK" ? AddLandmarkPrior(id, v)
+                                      : AddGroundTruthLandmark(id, v);
+    }
+    if (name == "RANGE" || name == "BEARING" || name == "RANGE_BEARING") {
+      double t;
+      LandmarkId id;
+      double v[4];
+      if (!Numbers(fields, 1, 1, &t) || !ParseId(fields[2], &id) ||
+          !Numbers(fields, 3, fields.size() - 3, v)) {
+        return false;
+      }
+      return AddObservation(name, t, id, v);
+    }
+    double v[8];
+    if (!Numbers(fields, 1, fields.size() - 1, v)) return false;
+    if (name == "PRIOR_POSE") return AddPosePrior(v);
+    if (name == "ODOM") return AddOdometry(v);
+    return AddGroundTruthPose(v);  // GT_POSE, the last one left.
+  }
+
+  bool seen_header() const { return seen_header_; }
+
+ private:
+  bool Fail(const std::string& message) {
+    *error_ = reader_.Error(message);
+    return false;
+  }
+
+  bool Numbers(const std::vector<std::string_view>& fields, std::size_t first,
+               std::size_t count, double* values) {
+    return ParseFiniteDoubles(reader_, fields, first, count, values, error_);
+  }
+
+  bool ParseId(std::string_view field, LandmarkId* id) {
+    if (!ParseNonNegativeInt(field, id)) {
+      return Fail("landmark id '" + std::string(field.substr(0, 64)) +
+                  "' is not a non-negative 64-bit integer");
+    }
+    return true;
+  }
+
+  bool Positive(double sigma, const char* what) {
+    if (!(sigma > 0.0)) {
+      return Fail(std::string(what) + " must be > 0, got " +
+                  FormatNumber(sigma));
+    }
+    return true;
+  }
+
+  bool ParseHeader(const std::vector<std::string_view>& fields) {
+    if (seen_header_) return Fail("second RFFD header");
+    if (fields[1] != "1") {
+      return Fail("unsupported RFFD version '" +
+                  std::string(fields[1].substr(0, 64)) + "' (expected 1)");
+    }
+    seen_header_ = true;
+    return true;
+  }
+
+  bool AddPosePrior(const double* v) {
+    if (!Positive(v[4], "sigma_xy") || !Positive(v[5], "sigma_theta")) {
+      return false;
+    }
+    dataset_->pose_priors.push_back(
+        {{v[0], v[1], v[2], WrapAngle(v[3])}, v[4], v[5]});
+    return true;
+  }
+
+  bool AddLandmarkPrior(LandmarkId id, const double* v) {
+    if (!Positive(v[2], "sigma")) return false;
+    if (!prior_ids_.insert(id).second) {
+      return Fail("duplicate PRIOR_LANDMARK for landmark " +
+                  std::to_string(id));
+    }
+    dataset_->landmark_priors.push_back({id, v[0], v[1], v[2]});
+    return true;
+  }
+
+  bool AddGroundTruthLandmark(LandmarkId id, const double* v) {
+    if (!truth_ids_.insert(id).second) {
+      return Fail("duplicate GT_LANDMARK for landmark " + std::to_string(id));
+    }
+    Landmark landmark;
+    landmark.id = id;
+    landmark.x = v[0];
+    landmark.y = v[1];
+    dataset_->ground_truth_landmarks.push_back(landmark);
+    return true;
+  }
+
+  bool AddOdometry(const double* v) {
+    if (!(v[1] > v[0])) {
+      return Fail("ODOM needs t1 > t0, got t0 = " + FormatNumber(v[0]) +
+                  ", t1 = " + FormatNumber(v[1]));
+    }
+    if (!Positive(v[5], "sigma_x") || !Positive(v[6], "sigma_y") ||
+        !Positive(v[7], "sigma_theta")) {
+      return false;
+    }
+    dataset_->odometry.push_back(
+        {v[0], v[1], v[2], v[3], WrapAngle(v[4]), v[5], v[6], v[7]});
+    return true;
+  }
+
+  bool AddObservation(std::string_view name, double t, LandmarkId id,
+                      const double* v) {
+    Observation obs;
+    obs.t = t;
+    obs.id = id;
+    if (name == "RANGE") {
+      obs.type = ObservationType::kRange;
+      obs.range = v[0];
+      obs.sigma_range = v[1];
+    } else if (name == "BEARING") {
+      obs.type = ObservationType::kBearing;
+      obs.bearing = WrapAngle(v[0]);
+      obs.sigma_bearing = v[1];
+    } else {
+      obs.type = ObservationType::kRangeBearing;
+      obs.range = v[0];
+      obs.bearing = WrapAngle(v[1]);
+      obs.sigma_range = v[2];
+      obs.sigma_bearing = v[3];
+    }
+    if (obs.HasRange()) {
+      if (obs.range < 0.0) {
+        return Fail("range must be >= 0, got " + FormatNumber(obs.range));
+      }
+      if (!Positive(obs.sigma_range, "sigma_range")) return false;
+    }
+    if (obs.HasBearing() && !Positive(obs.sigma_bearing, "sigma_bearing")) {
+      return false;
+    }
+    dataset_->observations.push_back(obs);
+    return true;
+  }
+
+  bool AddGroundTruthPose(const double* v) {
+    dataset_->ground_truth.push_back({v[0], v[1], v[2], WrapAngle(v[3])});
+    return true;
+  }
+
+  const LineReader& reader_;
+  Dataset* dataset_;
+  std::string* error_ = nullptr;
+  bool seen_header_ = false;
+  std::set<LandmarkId> prior_ids_;
+  std::set<LandmarkId> truth_ids_;
+};
+
+// Turns the leading "# key: value" comments into metadata pairs.
+void ParseMetadata(const std::vector<std::string>& comments, Dataset* dataset) {
+  for (const std::string& comment : comments) {
+    const std::size_t colon = comment.find(':');
+    if (colon == std::string::npos) continue;  // Prose, not metadata.
+    auto trim = [](std::string s) {
+      const auto begin = s.find_first_not_of(" \t");
+      if (begin == std::string::npos) return std::string();
+      const auto end = s.find_last_not_of(" \t");
+      return s.substr(begin, end - begin + 1);
+    };
+    std::string key = trim(comment.substr(0, colon));
+    if (key.empty() || key.find_first_of(" \t") != std::string::npos) continue;
+    dataset->metadata.emplace_back(key, trim(comment.substr(colon + 1)));
+  }
+}
+
+}  // namespace
+
+bool ParseDataset(std::istream* input, const std::string& source,
+                  Dataset* dataset, std::string* error) {
+  *dataset = Dataset();
+  LineReader reader(input, source);
+  DatasetParser parser(&reader, dataset);
+  std::vector<std::string_view> fields;
+  while (reader.Next(&fields)) {
+    if (!parser.ParseRecord(fields, error)) return false;
+  }
+  if (!reader.ok()) {
+    *error = reader.error();
+    return false;
+  }
+  if (!parser.seen_header()) {
+    *error = source + ": missing header: no 'RFFD 1' record (empty file?)";
+    return false;
+  }
+  if (dataset->pose_priors.empty()) {
+    *error = source +
+             ": no PRIOR_POSE record (every dataset needs one to anchor the "
+             "trajectory)";
+    return false;
+  }
+  ParseMetadata(reader.leading_comments(), dataset);
+
+  // Records may come in any order: sort them once here (stable, so equal
+  // times keep their file order).
+  std::stable_sort(
+      dataset->observations.begin(), dataset->observations.end(),
+      [](const Observation& a, const Observation& b) { return a.t < b.t; });
+  std::stable_sort(
+      dataset->odometry.begin(), dataset->odometry.end(),
+      [](const Odometry& a, const Odometry& b) { return a.t0 < b.t0; });
+  std::stable_sort(
+      dataset->ground_truth.begin(), dataset->ground_truth.end(),
+      [](const TimedPose& a, const TimedPose& b) { return a.t < b.t; });
+  for (std::size_t i = 1; i < dataset->ground_truth.size(); ++i) {
+    if (dataset->ground_truth[i].t == dataset->ground_truth[i - 1].t) {
+      *error = source + ": two GT_POSE records at time " +
+               FormatNumber(dataset->ground_truth[i].t);
+      return false;
+    }
+  }
+  std::sort(dataset->landmark_priors.begin(), dataset->landmark_priors.end(),
+            [](const LandmarkPrior& a, const LandmarkPrior& b) {
+              return a.id < b.id;
+            });
+  std::sort(dataset->ground_truth_landmarks.begin(),
+            dataset->ground_truth_landmarks.end(),
+            [](const Landmark& a, const Landmark& b) { return a.id < b.id; });
+  return true;
+}
+
+bool ReadDataset(const std::string& path, Dataset* dataset,
+                 std::string* error) {
+  std::ifstream stream;
+  if (!OpenForReading(path, &stream, error)) return false;
+  return ParseDataset(&stream, path, dataset, error);
+}
+
+void WriteDataset(const Dataset& dataset, std::ostream* output) {
+  std::ostream& out = *output;
+  for (const auto& [key, value] : dataset.metadata) {
+    out << "# " << key << ": " << value << "\n";
+  }
+  out << "RFFD 1\n";
+  auto n = [](double v) { return FormatNumber(v); };
+  for (const PosePrior& p : dataset.pose_priors) {
+    out << "PRIOR_POSE " << n(p.pose.t) << " " << n(p.pose.x) << " "
+        << n(p.pose.y) << " " << n(p.pose.theta) << " " << n(p.sigma_xy) << " "
+        << n(p.sigma_theta) << "\n";
+  }
+  for (const LandmarkPrior& p : dataset.landmark_priors) {
+    out << "PRIOR_LANDMARK " << p.id << " " << n(p.x) << " " << n(p.y) << " "
+        << n(p.sigma) << "\n";
+  }
+  for (const Odometry& o : dataset.odometry) {
+    out << "ODOM " << n(o.t0) << " " << n(o.t1) << " " << n(o.dx) << " "
+        << n(o.dy) << " " << n(o.dtheta) << " " << n(o.sigma_x) << " "
+        << n(o.sigma_y) << " " << n(o.sigma_theta) << "\n";
+  }
+  for (const Observation& o : dataset.observations) {
+    switch (o.type) {
+      case ObservationType::kRange:
+        out << "RANGE " << n(o.t) << " " << o.id << " " << n(o.range) << " "
+            << n(o.sigma_range) << "\n";
+        break;
+      case ObservationType::kBearing:
+        out << "BEARING " << n(o.t) << " " << o.id << " " << n(o.bearing) << " "
+            << n(o.sigma_bearing) << "\n";
+        break;
+      case ObservationType::kRangeBearing:
+        out << "RANGE_BEARING " << n(o.t) << " " << o.id << " " << n(o.range)
+            << " " << n(o.bearing) << " " << n(o.sigma_range) << " "
+            << n(o.sigma_bearing) << "\n";
+        break;
+    }
+  }
+  for (const TimedPose& p : dataset.ground_truth) {
+    out << "GT_POSE " << n(p.t) << " " << n(p.x) << " " << n(p.y) << " "
+        << n(p.theta) << "\n";
+  }
+  for (const Landmark& l : dataset.ground_truth_landmarks) {
+    out << "GT_LANDMARK " << l.id << " " << n(l.x) << " " << n(l.y) << "\n";
+  }
+}
+
+bool WriteDataset(const Dataset& dataset, const std::string& path,
+                  std::string* error) {
+  std::ofstream stream;
+  if (!OpenForWriting(path, &stream, error)) return false;
+  WriteDataset(dataset, &stream);
+  return FinishWriting(path, &stream, error);
+}
+
+}  // namespace rff

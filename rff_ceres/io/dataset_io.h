@@ -1,0 +1,31 @@
+// Reader and writer of the .rffd dataset format (docs/FORMAT.md).
+#ifndef RFF_CERES_IO_DATASET_IO_H_
+#define RFF_CERES_IO_DATASET_IO_H_
+
+#include <istream>
+#include <ostream>
+#include <string>
+
+#include "rff_ceres/types.h"
+
+namespace rff {
+
+// Reads a .rffd file. Returns false and sets `error` to "path:line: problem"
+// on the first malformed record; never skips a line. On success the
+// observations, odometry and ground truth are sorted by time and the landmark
+// lists by id.
+bool ReadDataset(const std::string& path, Dataset* dataset, std::string* error);
+
+// The same from a stream; `source` names it in error messages.
+bool ParseDataset(std::istream* input, const std::string& source,
+                  Dataset* dataset, std::string* error);
+
+// Writes `dataset` as .rffd (metadata as leading `# key: value` comments).
+// Numbers are written in the shortest form that reads back exactly.
+void WriteDataset(const Dataset& dataset, std::ostream* output);
+bool WriteDataset(const Dataset& dataset, const std::string& path,
+                  std::string* error);
+
+}  // namespace rff
+
+#endif  // RFF_CERES_IO_DATASET_IO_H_

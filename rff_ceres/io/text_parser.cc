@@ -1,0 +1,165 @@
+#include "rff_ceres/io/text_parser.h"
+
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <limits>
+
+namespace rff {
+
+LineReader::LineReader(std::istream* input, std::string source)
+    : input_(input), source_(std::move(source)) {}
+
+std::string LineReader::Error(const std::string& message) const {
+  return source_ + ":" + std::to_string(line_number_) + ": " + message;
+}
+
+bool LineReader::Next(std::vector<std::string_view>* fields) {
+  fields->clear();
+  while (true) {
+    comment_ = std::string_view();
+    line_.clear();
+    // Read one line by hand so that a huge line is refused before it is
+    // held in memory whole.
+    bool got_any = false;
+    int c;
+    while ((c = input_->get()) != std::char_traits<char>::eof()) {
+      got_any = true;
+      if (c == '\n') break;
+      if (line_.size() >= kMaxLineLength) {
+        ++line_number_;
+        error_ = Error("line longer than " + std::to_string(kMaxLineLength) +
+                       " bytes (binary or broken file?)");
+        return false;
+      }
+      line_.push_back(static_cast<char>(c));
+    }
+    if (!got_any) {
+      if (input_->bad()) error_ = Error("read error");
+      return false;
+    }
+    ++line_number_;
+    if (!line_.empty() && line_.back() == '\r') line_.pop_back();
+    if (line_.find('\0') != std::string::npos) {
+      error_ = Error("NUL byte in line (binary file?)");
+      return false;
+    }
+    std::string_view text(line_);
+    const std::size_t hash = text.find('#');
+    if (hash != std::string_view::npos) {
+      comment_ = text.substr(hash + 1);
+      text = text.substr(0, hash);
+    }
+    std::size_t i = 0;
+    while (i < text.size()) {
+      while (i < text.size() && (text[i] == ' ' || text[i] == '\t')) ++i;
+      if (i >= text.size()) break;
+      std::size_t j = i;
+      while (j < text.size() && text[j] != ' ' && text[j] != '\t') ++j;
+      fields->push_back(text.substr(i, j - i));
+      i = j;
+    }
+    if (!fields->empty()) {
+      seen_record_ = true;
+      return true;
+    }
+    if (!seen_record_ && !comment_.empty()) {
+      leading_comments_.emplace_back(comment_);
+    }
+  }
+}
+
+bool ParseFiniteDouble(std::string_view field, double* value) {
+  if (field.empty() || field.size() > 64) return false;
+  char buffer[65];
+  std::memcpy(buffer, field.data(), field.size());
+  buffer[field.size()] = '\0';
+  char* end = nullptr;
+  errno = 0;
+  const double parsed = std::strtod(buffer, &end);
+  if (end != buffer + field.size()) return false;
+  if (!std::isfinite(parsed)) return false;
+  // strtod sets ERANGE on overflow (returns inf, caught above) and on
+  // underflow; underflow to a denormal or zero is harmless.
+  *value = parsed;
+  return true;
+}
+
+bool ParseNonNegativeInt(std::string_view field, std::int64_t* value) {
+  if (field.empty()) return false;
+  std::int64_t result = 0;
+  for (const char c : field) {
+    if (c < '0' || c > '9') return false;
+    const int digit = c - '0';
+    if (result > (std::numeric_limits<std::int64_t>::max() - digit) / 10) {
+      return false;
+    }
+    result = result * 10 + digit;
+  }
+  *value = result;
+  return true;
+}
+
+bool ParseFiniteDoubles(const LineReader& reader,
+                        const std::vector<std::string_view>& fields,
+                        std::size_t first, std::size_t count, double* values,
+                        std::string* error) {
+  for (std::size_t k = 0; k < count; ++k) {
+    const std::string_view field = fields[first + k];
+    if (!ParseFiniteDouble(field, &values[k])) {
+      *error = reader.Error("field " + std::to_string(first + k + 1) + " '" +
+                            std::string(field.substr(0, 64)) +
+                            "' is not a finite number");
+      return false;
+    }
+  }
+  return true;
+}
+
+std::string FormatNumber(double value) {
+  char buffer[64];
+  const auto result = std::to_chars(buffer, buffer + sizeof(buffer), value);
+  return std::string(buffer, result.ptr);
+}
+
+double WrapAngle(double angle) {
+  // remainder() maps to [-pi, pi]; fold -pi onto pi for (-pi, pi].
+  double wrapped = std::remainder(angle, 2.0 * M_PI);
+  if (wrapped <= -M_PI) wrapped += 2.0 * M_PI;
+  return wrapped;
+}
+
+bool OpenForReading(const std::string& path, std::ifstream* stream,
+                    std::string* error) {
+  stream->open(path, std::ios::in | std::ios::binary);
+  if (!stream->is_open()) {
+    *error = path + ": cannot open for reading: " + std::strerror(errno);
+    return false;
+  }
+  return true;
+}
+
+bool OpenForWriting(const std::string& path, std::ofstream* stream,
+                    std::string* error) {
+  stream->open(path, std::ios::out | std::ios::trunc);
+  if (!stream->is_open()) {
+    *error = path + ": cannot open for writing: " + std::strerror(errno);
+    return false;
+  }
+  return true;
+}
+
+bool FinishWriting(const std::string& path, std::ofstream* stream,
+                   std::string* error) {
+  stream->flush();
+  if (!*stream) {
+    *error = path + ": write failed: " + std::strerror(errno);
+    return false;
+  }
+  return true;
+}
+
+}  // namespace rff

@@ -1,0 +1,77 @@
+#include "rff_ceres/io/text_parser.h"
+
+#include <cmath>
+#include <sstream>
+
+#include "gtest/gtest.h"
+
+namespace rff {
+namespace {
+
+TEST(TextParserTest, ParsesFiniteNumbersWhole) {
+  double v = 0.0;
+  EXPECT_TRUE(ParseFiniteDouble("1.5e-3", &v));
+  EXPECT_DOUBLE_EQ(v, 1.5e-3);
+  EXPECT_TRUE(ParseFiniteDouble("-0", &v));
+  EXPECT_EQ(v, 0.0);
+  EXPECT_TRUE(std::signbit(v));
+  EXPECT_TRUE(ParseFiniteDouble("1e-400", &v));  // Underflow is harmless.
+  EXPECT_FALSE(ParseFiniteDouble("", &v));
+  EXPECT_FALSE(ParseFiniteDouble("1.5x", &v));
+  EXPECT_FALSE(ParseFiniteDouble("nan", &v));
+  EXPECT_FALSE(ParseFiniteDouble("-inf", &v));
+  EXPECT_FALSE(ParseFiniteDouble("1e999", &v));
+  EXPECT_FALSE(ParseFiniteDouble(std::string(100, '1'), &v));
+}
+
+TEST(TextParserTest, ParsesNonNegativeIntegers) {
+  std::int64_t id = -1;
+  EXPECT_TRUE(ParseNonNegativeInt("0", &id));
+  EXPECT_EQ(id, 0);
+  EXPECT_TRUE(ParseNonNegativeInt("9223372036854775807", &id));
+  EXPECT_EQ(id, 9223372036854775807LL);
+  EXPECT_FALSE(ParseNonNegativeInt("9223372036854775808", &id));
+  EXPECT_FALSE(ParseNonNegativeInt("-1", &id));
+  EXPECT_FALSE(ParseNonNegativeInt("+1", &id));
+  EXPECT_FALSE(ParseNonNegativeInt("1e3", &id));
+  EXPECT_FALSE(ParseNonNegativeInt("", &id));
+}
+
+TEST(TextParserTest, WrapsAnglesToHalfOpenInterval) {
+  EXPECT_DOUBLE_EQ(WrapAngle(M_PI), M_PI);
+  EXPECT_DOUBLE_EQ(WrapAngle(-M_PI), M_PI);
+  EXPECT_NEAR(WrapAngle(3.0 * M_PI / 2.0), -M_PI / 2.0, 1e-15);
+  EXPECT_NEAR(WrapAngle(-7.0), -7.0 + 2.0 * M_PI, 1e-15);
+  EXPECT_DOUBLE_EQ(WrapAngle(0.25), 0.25);
+}
+
+TEST(TextParserTest, FormatNumberRoundTrips) {
+  for (const double v : {0.1 + 0.2, 1248444175.103, -1e-300, 0.0, 42.0}) {
+    double back = 0.0;
+    ASSERT_TRUE(ParseFiniteDouble(FormatNumber(v), &back));
+    EXPECT_EQ(back, v);
+  }
+  EXPECT_EQ(FormatNumber(42.0), "42");
+}
+
+TEST(TextParserTest, SplitsFieldsSkipsCommentsAndCountsLines) {
+  std::istringstream in("# key: value\n\n  a\tb  # c\r\n#x\nd\n");
+  LineReader reader(&in, "f.txt");
+  std::vector<std::string_view> fields;
+  ASSERT_TRUE(reader.Next(&fields));
+  ASSERT_EQ(fields.size(), 2u);
+  EXPECT_EQ(fields[0], "a");
+  EXPECT_EQ(fields[1], "b");
+  EXPECT_EQ(reader.line_number(), 3);
+  ASSERT_TRUE(reader.Next(&fields));
+  EXPECT_EQ(fields[0], "d");
+  EXPECT_EQ(reader.line_number(), 5);
+  EXPECT_FALSE(reader.Next(&fields));
+  EXPECT_TRUE(reader.ok());
+  ASSERT_EQ(reader.leading_comments().size(), 1u);
+  EXPECT_EQ(reader.leading_comments()[0], " key: value");
+  EXPECT_EQ(reader.Error("bad"), "f.txt:5: bad");
+}
+
+}  // namespace
+}  // namespace rff
