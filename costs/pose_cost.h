@@ -1,0 +1,90 @@
+// Base of every cost that observes one or more trajectory poses (through
+// their PoseMaps) and optionally one landmark. The parameter blocks are the
+// blocks of the pose maps, indexed as their terms say, followed by the 2-D
+// landmark block when there is one. A derived cost supplies only the residual
+// and its gradients with respect to the poses and the landmark; this class
+// evaluates the poses and maps the gradients onto the weight blocks.
+#ifndef RFF_COSTS_POSE_COST_H_
+#define RFF_COSTS_POSE_COST_H_
+
+#include <array>
+#include <utility>
+#include <vector>
+
+#include "Eigen/Core"
+#include "ceres/cost_function.h"
+#include "costs/pose_map.h"
+
+namespace rff {
+
+template <int kNumResiduals, int kNumPoses, bool kHasLandmark>
+class PoseCost : public ceres::CostFunction {
+ public:
+  using PoseGradient = Eigen::Matrix<double, kNumResiduals, 3, Eigen::RowMajor>;
+  using LandmarkGradient =
+      Eigen::Matrix<double, kNumResiduals, 2, Eigen::RowMajor>;
+  using Residuals = Eigen::Matrix<double, kNumResiduals, 1>;
+
+  explicit PoseCost(std::array<PoseMap, kNumPoses> maps)
+      : maps_(std::move(maps)) {
+    set_num_residuals(kNumResiduals);
+    std::vector<int> sizes;
+    for (const PoseMap& map : maps_) ExtendBlockSizes(map, &sizes);
+    num_pose_blocks_ = static_cast<int>(sizes.size());
+    if (kHasLandmark) sizes.push_back(2);
+    *mutable_parameter_block_sizes() = sizes;
+  }
+
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const final {
+    std::array<Eigen::Vector3d, kNumPoses> poses;
+    for (int k = 0; k < kNumPoses; ++k) {
+      poses[k] = EvaluatePose(maps_[k], parameters);
+    }
+    const Eigen::Vector2d landmark =
+        kHasLandmark ? Eigen::Vector2d(parameters[num_pose_blocks_][0],
+                                       parameters[num_pose_blocks_][1])
+                     : Eigen::Vector2d::Zero();
+    Eigen::Map<Residuals> r(residuals);
+    if (jacobians == nullptr) {
+      return Residual(poses, landmark, &r, nullptr, nullptr);
+    }
+    std::array<PoseGradient, kNumPoses> dr_dposes;
+    LandmarkGradient dr_dlandmark;
+    if (!Residual(poses, landmark, &r, &dr_dposes, &dr_dlandmark)) {
+      return false;
+    }
+    for (const PoseMap& map : maps_) {
+      ZeroPoseJacobians(map, kNumResiduals, jacobians);
+    }
+    for (int k = 0; k < kNumPoses; ++k) {
+      AccumulatePoseJacobians(maps_[k], dr_dposes[k].data(), kNumResiduals,
+                              jacobians);
+    }
+    if (kHasLandmark && jacobians[num_pose_blocks_] != nullptr) {
+      Eigen::Map<LandmarkGradient> jacobian(jacobians[num_pose_blocks_]);
+      jacobian = dr_dlandmark;
+    }
+    return true;
+  }
+
+  const PoseMap& map(int k) const { return maps_[k]; }
+
+ protected:
+  // Fills the residual and, when the gradient pointers are non-null, its
+  // derivatives with respect to each pose (x, y, theta) and the landmark.
+  // Returns false where the residual is undefined.
+  virtual bool Residual(const std::array<Eigen::Vector3d, kNumPoses>& poses,
+                        const Eigen::Vector2d& landmark,
+                        Eigen::Map<Residuals>* residual,
+                        std::array<PoseGradient, kNumPoses>* dr_dposes,
+                        LandmarkGradient* dr_dlandmark) const = 0;
+
+ private:
+  std::array<PoseMap, kNumPoses> maps_;
+  int num_pose_blocks_ = 0;
+};
+
+}  // namespace rff
+
+#endif  // RFF_COSTS_POSE_COST_H_
