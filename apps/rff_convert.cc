@@ -1,0 +1,203 @@
+// rff_convert: converts a raw public dataset to .rffd (docs/converters.md).
+//
+//   rff_convert --format=plaza --input=DIR --output=OUT.rffd
+//       [--plaza_calibration=linear|none]
+//   rff_convert --format=mrclam --input=DIR --mrclam_robot=N --output=OUT.rffd
+//       [--mrclam_odometry_interval=SECONDS]
+#include <gflags/gflags.h>
+
+#include <cstdio>
+#include <map>
+#include <string>
+
+#include "rff_ceres/convert/mrclam.h"
+#include "rff_ceres/convert/plaza.h"
+#include "rff_ceres/io/dataset_io.h"
+#include "rff_ceres/io/text_parser.h"
+
+DEFINE_string(format, "", "Raw layout of --input: plaza or mrclam");
+DEFINE_string(input, "", "Directory with the raw dataset files");
+DEFINE_string(output, "", "The .rffd file to write");
+DEFINE_double(prior_sigma_xy, -1.0,
+              "PRIOR_POSE position sigma [m] (-1: format default, plaza "
+              "0.02, mrclam 0.01)");
+DEFINE_double(prior_sigma_theta, 0.01, "PRIOR_POSE heading sigma [rad]");
+
+DEFINE_string(plaza_name, "Plaza1", "File prefix: reads NAME_GT.txt, ...");
+DEFINE_string(plaza_calibration, "linear",
+              "linear: fit r_true ~ a * r + b against ground truth and drop "
+              "outliers; none: keep the raw ranges");
+DEFINE_double(plaza_outlier_threshold, 2.0,
+              "Drop ranges with |a * r + b - r_true| above this [m]");
+DEFINE_double(plaza_range_sigma, 0.0,
+              "RANGE sigma [m]; 0: fitted inlier sigma rounded to 0.1 m");
+DEFINE_double(plaza_odom_sigma_xy_floor, 0.01, "ODOM x/y sigma floor [m]");
+DEFINE_double(plaza_odom_sigma_xy_per_m, 0.05,
+              "ODOM x/y sigma per metre travelled");
+DEFINE_double(plaza_odom_sigma_theta_floor, 0.005,
+              "ODOM heading sigma floor [rad]");
+DEFINE_double(plaza_odom_sigma_theta_per_rad, 0.05,
+              "ODOM heading sigma per radian turned");
+DEFINE_double(plaza_landmark_prior_sigma, 1.0,
+              "PRIOR_LANDMARK sigma at the surveyed beacons [m]; 0: none");
+
+DEFINE_int32(mrclam_robot, 0, "Robot number 1..5");
+DEFINE_double(mrclam_odometry_interval, 0.0,
+              "Longest ODOM step between measurement times [s]; 0: poses "
+              "only at measurement times");
+DEFINE_double(mrclam_range_sigma, 0.1, "RANGE_BEARING range sigma [m]");
+DEFINE_double(mrclam_bearing_sigma, 0.02, "RANGE_BEARING bearing sigma [rad]");
+DEFINE_double(mrclam_odom_sigma_xy_floor, 0.005, "ODOM x/y sigma floor [m]");
+DEFINE_double(mrclam_odom_sigma_xy_per_m, 0.1,
+              "ODOM x/y sigma per metre travelled");
+DEFINE_double(mrclam_odom_sigma_theta_floor, 0.01,
+              "ODOM heading sigma floor [rad]");
+DEFINE_double(mrclam_odom_sigma_theta_per_s, 0.05,
+              "ODOM heading sigma per second of the step [rad/s]");
+DEFINE_double(mrclam_landmark_prior_sigma, 0.1,
+              "PRIOR_LANDMARK sigma at the Vicon landmarks [m]; 0: none");
+DEFINE_double(gt_rate_hz, 10.0,
+              "mrclam: thin GT_POSE to at most this rate; 0 keeps all rows");
+
+namespace {
+
+int Fail(const std::string& message) {
+  std::fprintf(stderr, "rff_convert: %s\n", message.c_str());
+  return 1;
+}
+
+void PrintRecordCounts(const rff::Dataset& d) {
+  std::map<std::string, std::size_t> observations;
+  for (const rff::Observation& o : d.observations) {
+    switch (o.type) {
+      case rff::ObservationType::kRange:
+        ++observations["RANGE"];
+        break;
+      case rff::ObservationType::kBearing:
+        ++observations["BEARING"];
+        break;
+      case rff::ObservationType::kRangeBearing:
+        ++observations["RANGE_BEARING"];
+        break;
+    }
+  }
+  std::printf("records: PRIOR_POSE %zu, PRIOR_LANDMARK %zu, ODOM %zu",
+              d.pose_priors.size(), d.landmark_priors.size(),
+              d.odometry.size());
+  for (const auto& [name, count] : observations) {
+    std::printf(", %s %zu", name.c_str(), count);
+  }
+  std::printf(", GT_POSE %zu, GT_LANDMARK %zu\n", d.ground_truth.size(),
+              d.ground_truth_landmarks.size());
+}
+
+bool ConvertPlaza(rff::Dataset* dataset, std::string* error) {
+  rff::PlazaOptions options;
+  options.name = FLAGS_plaza_name;
+  if (!rff::ParsePlazaCalibration(FLAGS_plaza_calibration, &options.calibration,
+                                  error)) {
+    return false;
+  }
+  options.outlier_threshold = FLAGS_plaza_outlier_threshold;
+  options.range_sigma = FLAGS_plaza_range_sigma;
+  options.odometry_sigma_xy_floor = FLAGS_plaza_odom_sigma_xy_floor;
+  options.odometry_sigma_xy_per_metre = FLAGS_plaza_odom_sigma_xy_per_m;
+  options.odometry_sigma_theta_floor = FLAGS_plaza_odom_sigma_theta_floor;
+  options.odometry_sigma_theta_per_radian =
+      FLAGS_plaza_odom_sigma_theta_per_rad;
+  options.landmark_prior_sigma = FLAGS_plaza_landmark_prior_sigma;
+  if (FLAGS_prior_sigma_xy >= 0.0) {
+    options.first_pose_sigma_xy = FLAGS_prior_sigma_xy;
+  }
+  options.first_pose_sigma_theta = FLAGS_prior_sigma_theta;
+  rff::PlazaSummary s;
+  if (!rff::ConvertPlaza(FLAGS_input, options, dataset, &s, error)) {
+    return false;
+  }
+  std::printf(
+      "plaza: %zu ground-truth rows, %zu odometry rows, %zu range rows "
+      "(%zu out of time order, sorted)\n",
+      s.ground_truth_rows, s.odometry_rows, s.range_rows,
+      s.ranges_out_of_order);
+  std::printf(
+      "calibration fit r_true ~ a * r + b: a = %.6f, b = %.6f m, inlier "
+      "sigma = %.4f m, %zu inliers of %zu (threshold %g m)\n",
+      s.fit.a, s.fit.b, s.fit.inlier_sigma, s.fit.num_inliers,
+      s.fit.inlier.size(), options.outlier_threshold);
+  std::printf(
+      "ranges: calibration %s, kept %zu of %zu, rejected %zu, outside the "
+      "ground-truth times %zu, sigma %g m\n",
+      FLAGS_plaza_calibration.c_str(), s.ranges_kept, s.range_rows,
+      s.ranges_rejected, s.ranges_outside_span, s.range_sigma);
+  return true;
+}
+
+bool ConvertMrclam(rff::Dataset* dataset, std::string* error) {
+  rff::MrclamOptions options;
+  options.robot = FLAGS_mrclam_robot;
+  options.odometry_interval = FLAGS_mrclam_odometry_interval;
+  options.range_sigma = FLAGS_mrclam_range_sigma;
+  options.bearing_sigma = FLAGS_mrclam_bearing_sigma;
+  options.odometry_sigma_xy_floor = FLAGS_mrclam_odom_sigma_xy_floor;
+  options.odometry_sigma_xy_per_metre = FLAGS_mrclam_odom_sigma_xy_per_m;
+  options.odometry_sigma_theta_floor = FLAGS_mrclam_odom_sigma_theta_floor;
+  options.odometry_sigma_theta_per_second = FLAGS_mrclam_odom_sigma_theta_per_s;
+  options.landmark_prior_sigma = FLAGS_mrclam_landmark_prior_sigma;
+  if (FLAGS_prior_sigma_xy >= 0.0) {
+    options.first_pose_sigma_xy = FLAGS_prior_sigma_xy;
+  }
+  options.first_pose_sigma_theta = FLAGS_prior_sigma_theta;
+  options.gt_rate_hz = FLAGS_gt_rate_hz;
+  rff::MrclamSummary s;
+  if (!rff::ConvertMrclam(FLAGS_input, options, dataset, &s, error)) {
+    return false;
+  }
+  std::printf(
+      "mrclam robot %d: %zu odometry rows, %zu ground-truth rows, %zu "
+      "measurement rows\n",
+      options.robot, s.odometry_rows, s.ground_truth_rows, s.measurement_rows);
+  std::printf(
+      "measurements: kept %zu, dropped %zu of robots, %zu of unknown "
+      "barcodes, %zu outside the odometry/ground-truth times\n",
+      s.measurements_kept, s.dropped_robot, s.dropped_unknown,
+      s.dropped_outside_span);
+  std::printf(
+      "agreement with Vicon: range residual median %.4f m, MAD %.4f m; "
+      "bearing residual median %.4f rad, MAD %.4f rad\n",
+      s.agreement.range_median, s.agreement.range_mad,
+      s.agreement.bearing_median, s.agreement.bearing_mad);
+  std::printf("trajectory: %zu pose times, %zu GT_POSE kept\n",
+              s.trajectory_times, s.ground_truth_kept);
+  return true;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  gflags::SetUsageMessage(
+      "converts a raw dataset to .rffd\n"
+      "  rff_convert --format=plaza --input=DIR --output=OUT.rffd "
+      "[--plaza_calibration=linear|none]\n"
+      "  rff_convert --format=mrclam --input=DIR --mrclam_robot=N "
+      "--output=OUT.rffd [--mrclam_odometry_interval=SECONDS]");
+  gflags::ParseCommandLineFlags(&argc, &argv, true);
+  if (argc > 1)
+    return Fail(std::string("unexpected argument '") + argv[1] + "'");
+  if (FLAGS_input.empty()) return Fail("--input=DIR is required");
+  if (FLAGS_output.empty()) return Fail("--output=OUT.rffd is required");
+  rff::Dataset dataset;
+  std::string error;
+  bool ok;
+  if (FLAGS_format == "plaza") {
+    ok = ConvertPlaza(&dataset, &error);
+  } else if (FLAGS_format == "mrclam") {
+    ok = ConvertMrclam(&dataset, &error);
+  } else {
+    return Fail("--format must be plaza or mrclam, got '" + FLAGS_format + "'");
+  }
+  if (!ok) return Fail(error);
+  if (!rff::WriteDataset(dataset, FLAGS_output, &error)) return Fail(error);
+  PrintRecordCounts(dataset);
+  std::printf("wrote %s\n", FLAGS_output.c_str());
+  return 0;
+}

@@ -1,0 +1,83 @@
+// rff_evaluate: APE, RPE and landmark error of an estimated trajectory (TUM)
+// and optional landmark file against the ground truth of a .rffd dataset.
+//
+//   rff_evaluate --dataset=IN.rffd --trajectory=EST.tum
+//                [--landmarks=EST.landmarks] [--align] [--json=OUT.json]
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include "gflags/gflags.h"
+#include "rff_ceres/io/dataset_io.h"
+#include "rff_ceres/io/landmarks_io.h"
+#include "rff_ceres/io/tum_io.h"
+#include "rff_ceres/metrics.h"
+
+DEFINE_string(dataset, "", "Dataset (.rffd) with GT_POSE (and GT_LANDMARK).");
+DEFINE_string(trajectory, "", "Estimated trajectory (TUM).");
+DEFINE_string(landmarks, "", "Estimated landmarks (.landmarks), optional.");
+DEFINE_bool(align, false,
+            "Align the estimate onto the ground truth (least-squares SE(2), "
+            "positions) before computing the errors.");
+DEFINE_string(json, "", "Also write the metrics as JSON to this file.");
+
+namespace {
+
+int Fail(const std::string& message) {
+  std::cerr << "rff_evaluate: error: " << message << "\n";
+  return 1;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  gflags::SetUsageMessage(
+      "rff_evaluate --dataset=IN.rffd --trajectory=EST.tum "
+      "[--landmarks=EST.landmarks] [--align] [--json=OUT.json]");
+  gflags::ParseCommandLineFlags(&argc, &argv, true);
+  if (argc > 1)
+    return Fail(std::string("unexpected argument '") + argv[1] + "'");
+  if (FLAGS_dataset.empty()) return Fail("--dataset is required");
+  if (FLAGS_trajectory.empty()) return Fail("--trajectory is required");
+
+  std::string error;
+  rff::Dataset dataset;
+  if (!rff::ReadDataset(FLAGS_dataset, &dataset, &error)) return Fail(error);
+  if (dataset.ground_truth.empty()) {
+    return Fail(FLAGS_dataset +
+                ": no GT_POSE record, nothing to evaluate against");
+  }
+  std::vector<rff::TimedPose> trajectory;
+  if (!rff::ReadTum(FLAGS_trajectory, &trajectory, &error)) return Fail(error);
+  std::vector<rff::Landmark> landmarks;
+  if (!FLAGS_landmarks.empty() &&
+      !rff::ReadLandmarks(FLAGS_landmarks, &landmarks, &error)) {
+    return Fail(error);
+  }
+
+  rff::EvaluationOptions options;
+  options.align = FLAGS_align;
+  rff::Evaluation evaluation;
+  if (!rff::Evaluate(dataset.ground_truth, dataset.ground_truth_landmarks,
+                     trajectory, FLAGS_landmarks.empty() ? nullptr : &landmarks,
+                     options, &evaluation, &error)) {
+    return Fail(FLAGS_trajectory + ": " + error);
+  }
+  std::cout << "dataset: " << FLAGS_dataset
+            << "\ntrajectory: " << FLAGS_trajectory << "\n";
+  if (!FLAGS_landmarks.empty()) {
+    std::cout << "landmarks: " << FLAGS_landmarks << "\n";
+  }
+  rff::PrintEvaluation(evaluation, &std::cout);
+
+  if (!FLAGS_json.empty()) {
+    std::vector<std::pair<std::string, std::string>> inputs = {
+        {"dataset", FLAGS_dataset}, {"trajectory", FLAGS_trajectory}};
+    if (!FLAGS_landmarks.empty())
+      inputs.push_back({"landmarks", FLAGS_landmarks});
+    if (!rff::WriteEvaluationJson(evaluation, inputs, FLAGS_json, &error)) {
+      return Fail(error);
+    }
+  }
+  return 0;
+}

@@ -1,0 +1,549 @@
+#include "rff_ceres/convert/mrclam.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <set>
+#include <string_view>
+
+#include "rff_ceres/io/text_parser.h"
+
+namespace rff {
+namespace {
+
+// Subjects 1..5 are the robots of the dataset; 6..20 are landmarks.
+constexpr LandmarkId kLastRobotSubject = 5;
+
+// Reads every record of `path`; each must have exactly `num_fields` fields.
+// `parse_row(reader, fields, error)` handles one record.
+template <typename RowParser>
+bool ReadRecords(const std::string& path, std::size_t num_fields,
+                 RowParser parse_row, std::string* error) {
+  std::ifstream stream;
+  if (!OpenForReading(path, &stream, error)) return false;
+  LineReader reader(&stream, path);
+  std::vector<std::string_view> fields;
+  std::size_t rows = 0;
+  while (reader.Next(&fields)) {
+    if (fields.size() != num_fields) {
+      *error = reader.Error("expected " + std::to_string(num_fields) +
+                            " fields, got " + std::to_string(fields.size()));
+      return false;
+    }
+    if (!parse_row(reader, fields, error)) return false;
+    ++rows;
+  }
+  if (!reader.ok()) {
+    *error = reader.error();
+    return false;
+  }
+  if (rows == 0) {
+    *error = path + ": no data rows";
+    return false;
+  }
+  return true;
+}
+
+bool ParseInteger(const LineReader& reader, std::string_view field, int column,
+                  LandmarkId* value, std::string* error) {
+  if (!ParseNonNegativeInt(field, value)) {
+    *error = reader.Error("field " + std::to_string(column) + " '" +
+                          std::string(field.substr(0, 64)) +
+                          "' is not a non-negative integer");
+    return false;
+  }
+  return true;
+}
+
+// Checks that row times do not decrease (strictly increase if `strict`).
+bool CheckTimeOrder(const LineReader& reader, bool have_previous,
+                    double previous, double t, bool strict,
+                    std::string* error) {
+  if (!have_previous) return true;
+  if (t > previous || (!strict && t == previous)) return true;
+  *error = reader.Error("time " + FormatNumber(t) +
+                        (strict ? " does not increase" : " decreases") +
+                        " (previous row " + FormatNumber(previous) + ")");
+  return false;
+}
+
+struct VelocityRow {
+  double t = 0.0;
+  double v = 0.0;
+  double omega = 0.0;
+};
+
+struct RawMeasurement {
+  double t = 0.0;
+  LandmarkId barcode = 0;
+  double range = 0.0;
+  double bearing = 0.0;
+};
+
+struct MrclamRaw {
+  std::map<LandmarkId, LandmarkId> subject_of_barcode;
+  std::map<LandmarkId, std::pair<double, double>> landmarks;
+  std::vector<VelocityRow> odometry;
+  std::vector<TimedPose> ground_truth;
+  std::vector<RawMeasurement> measurements;
+};
+
+bool ReadBarcodes(const std::string& path, MrclamRaw* raw, std::string* error) {
+  return ReadRecords(
+      path, 2,
+      [&](const LineReader& reader, const std::vector<std::string_view>& f,
+          std::string* err) {
+        LandmarkId subject, barcode;
+        if (!ParseInteger(reader, f[0], 1, &subject, err) ||
+            !ParseInteger(reader, f[1], 2, &barcode, err)) {
+          return false;
+        }
+        if (!raw->subject_of_barcode.emplace(barcode, subject).second) {
+          *err = reader.Error("duplicate barcode " + std::to_string(barcode));
+          return false;
+        }
+        return true;
+      },
+      error);
+}
+
+bool ReadLandmarks(const std::string& path, MrclamRaw* raw,
+                   std::string* error) {
+  return ReadRecords(
+      path, 5,
+      [&](const LineReader& reader, const std::vector<std::string_view>& f,
+          std::string* err) {
+        LandmarkId subject;
+        double v[4];  // x y sx sy; the standard deviations are not used.
+        if (!ParseInteger(reader, f[0], 1, &subject, err) ||
+            !ParseFiniteDoubles(reader, f, 1, 4, v, err)) {
+          return false;
+        }
+        if (subject <= kLastRobotSubject) {
+          *err = reader.Error(
+              "subject " + std::to_string(subject) + " is a robot (1-" +
+              std::to_string(kLastRobotSubject) + "), not a landmark");
+          return false;
+        }
+        if (!raw->landmarks.emplace(subject, std::make_pair(v[0], v[1]))
+                 .second) {
+          *err = reader.Error("duplicate landmark " + std::to_string(subject));
+          return false;
+        }
+        return true;
+      },
+      error);
+}
+
+bool ReadOdometry(const std::string& path, MrclamRaw* raw, std::string* error) {
+  return ReadRecords(
+      path, 3,
+      [&](const LineReader& reader, const std::vector<std::string_view>& f,
+          std::string* err) {
+        double v[3];
+        if (!ParseFiniteDoubles(reader, f, 0, 3, v, err)) return false;
+        // Equal times occur in the data (a zero-length command); the later
+        // row then governs.
+        if (!CheckTimeOrder(
+                reader, !raw->odometry.empty(),
+                raw->odometry.empty() ? 0.0 : raw->odometry.back().t, v[0],
+                /*strict=*/false, err)) {
+          return false;
+        }
+        raw->odometry.push_back({v[0], v[1], v[2]});
+        return true;
+      },
+      error);
+}
+
+bool ReadGroundTruth(const std::string& path, MrclamRaw* raw,
+                     std::string* error) {
+  return ReadRecords(
+      path, 4,
+      [&](const LineReader& reader, const std::vector<std::string_view>& f,
+          std::string* err) {
+        double v[4];
+        if (!ParseFiniteDoubles(reader, f, 0, 4, v, err)) return false;
+        if (!CheckTimeOrder(
+                reader, !raw->ground_truth.empty(),
+                raw->ground_truth.empty() ? 0.0 : raw->ground_truth.back().t,
+                v[0], /*strict=*/true, err)) {
+          return false;
+        }
+        raw->ground_truth.push_back({v[0], v[1], v[2], v[3]});
+        return true;
+      },
+      error);
+}
+
+bool ReadMeasurements(const std::string& path, MrclamRaw* raw,
+                      std::string* error) {
+  return ReadRecords(
+      path, 4,
+      [&](const LineReader& reader, const std::vector<std::string_view>& f,
+          std::string* err) {
+        double t, rb[2];
+        LandmarkId barcode;
+        if (!ParseFiniteDoubles(reader, f, 0, 1, &t, err) ||
+            !ParseInteger(reader, f[1], 2, &barcode, err) ||
+            !ParseFiniteDoubles(reader, f, 2, 2, rb, err)) {
+          return false;
+        }
+        if (rb[0] < 0.0) {
+          *err = reader.Error("range must be >= 0, got " + FormatNumber(rb[0]));
+          return false;
+        }
+        raw->measurements.push_back({t, barcode, rb[0], rb[1]});
+        return true;
+      },
+      error);
+}
+
+// Ground-truth pose at time t inside the ground-truth times: linear in
+// position, along the shorter arc in heading.
+TimedPose InterpolatePose(const std::vector<TimedPose>& gt, double t) {
+  auto upper = std::upper_bound(
+      gt.begin(), gt.end(), t,
+      [](double time, const TimedPose& p) { return time < p.t; });
+  if (upper == gt.end()) upper = gt.end() - 1;
+  if (upper == gt.begin()) upper = gt.begin() + 1;
+  const TimedPose& p0 = *(upper - 1);
+  const TimedPose& p1 = *upper;
+  const double s = (t - p0.t) / (p1.t - p0.t);
+  return {t, p0.x + s * (p1.x - p0.x), p0.y + s * (p1.y - p0.y),
+          WrapAngle(p0.theta + s * WrapAngle(p1.theta - p0.theta))};
+}
+
+// The pose times: the distinct measurement times, with each gap longer
+// than `interval` (when > 0) split into equal steps rounded to the
+// millisecond.
+std::vector<double> TrajectoryTimes(const std::vector<double>& sorted_times,
+                                    double interval) {
+  std::vector<double> times;
+  for (const double t : sorted_times) {
+    if (!times.empty() && t == times.back()) continue;
+    if (!times.empty() && interval > 0.0) {
+      const double start = times.back();
+      const double gap = t - start;
+      const int steps = static_cast<int>(std::ceil(gap / interval - 1e-9));
+      for (int k = 1; k < steps; ++k) {
+        const double inner =
+            std::round((start + gap * k / steps) * 1000.0) / 1000.0;
+        if (inner > times.back() && inner < t) times.push_back(inner);
+      }
+    }
+    times.push_back(t);
+  }
+  return times;
+}
+
+// Integrates the piecewise-constant velocities of `rows` over [t0, t1],
+// starting from the identity. `row` is the index of a row with time <= t0;
+// it is advanced so that successive calls over increasing times are linear.
+void IntegrateBetween(const std::vector<VelocityRow>& rows, double t0,
+                      double t1, std::size_t* row, double* dx, double* dy,
+                      double* dtheta, double* path_length) {
+  while (*row + 1 < rows.size() && rows[*row + 1].t <= t0) ++*row;
+  *dx = *dy = *dtheta = *path_length = 0.0;
+  double now = t0;
+  std::size_t i = *row;
+  while (now < t1) {
+    const double end = i + 1 < rows.size() ? std::min(t1, rows[i + 1].t) : t1;
+    if (end > now) {
+      IntegrateUnicycle(rows[i].v, rows[i].omega, end - now, dx, dy, dtheta);
+      *path_length += std::abs(rows[i].v) * (end - now);
+      now = end;
+    }
+    if (i + 1 < rows.size() && rows[i + 1].t <= now) ++i;
+  }
+}
+
+double Median(std::vector<double> values) {
+  if (values.empty()) return 0.0;
+  const std::size_t mid = values.size() / 2;
+  std::nth_element(values.begin(), values.begin() + mid, values.end());
+  double median = values[mid];
+  if (values.size() % 2 == 0) {
+    median =
+        (median + *std::max_element(values.begin(), values.begin() + mid)) /
+        2.0;
+  }
+  return median;
+}
+
+// Median and median absolute deviation about the median.
+void MedianAndMad(const std::vector<double>& values, double* median,
+                  double* mad) {
+  *median = Median(values);
+  std::vector<double> deviations;
+  deviations.reserve(values.size());
+  for (const double v : values) deviations.push_back(std::abs(v - *median));
+  *mad = Median(deviations);
+}
+
+// The last component of `directory` ("mrclam6" for "data/mrclam6/"), which
+// names the dataset in the metadata.
+std::string DirectoryName(const std::string& directory) {
+  std::filesystem::path path = std::filesystem::path(directory);
+  if (path.filename().empty()) path = path.parent_path();
+  return path.filename().string();
+}
+
+std::string ConverterDescription(const MrclamOptions& o) {
+  auto n = [](double v) { return FormatNumber(v); };
+  return "rff_convert --format=mrclam --mrclam_robot=" +
+         std::to_string(o.robot) +
+         " --mrclam_odometry_interval=" + n(o.odometry_interval) +
+         " --mrclam_range_sigma=" + n(o.range_sigma) +
+         " --mrclam_bearing_sigma=" + n(o.bearing_sigma) +
+         " --mrclam_odom_sigma_xy_floor=" + n(o.odometry_sigma_xy_floor) +
+         " --mrclam_odom_sigma_xy_per_m=" + n(o.odometry_sigma_xy_per_metre) +
+         " --mrclam_odom_sigma_theta_floor=" + n(o.odometry_sigma_theta_floor) +
+         " --mrclam_odom_sigma_theta_per_s=" +
+         n(o.odometry_sigma_theta_per_second) +
+         " --mrclam_landmark_prior_sigma=" + n(o.landmark_prior_sigma) +
+         " --prior_sigma_xy=" + n(o.first_pose_sigma_xy) +
+         " --prior_sigma_theta=" + n(o.first_pose_sigma_theta) +
+         " --gt_rate_hz=" + n(o.gt_rate_hz);
+}
+
+bool CheckOptions(const MrclamOptions& o, std::string* error) {
+  auto positive = [&](double v, const char* name) {
+    if (v > 0.0 && std::isfinite(v)) return true;
+    *error = std::string(name) + " must be > 0, got " + FormatNumber(v);
+    return false;
+  };
+  auto non_negative = [&](double v, const char* name) {
+    if (v >= 0.0 && std::isfinite(v)) return true;
+    *error = std::string(name) + " must be >= 0, got " + FormatNumber(v);
+    return false;
+  };
+  if (o.robot < 1 || o.robot > kLastRobotSubject) {
+    *error = "mrclam_robot must be 1..5, got " + std::to_string(o.robot);
+    return false;
+  }
+  if (!non_negative(o.odometry_interval, "mrclam_odometry_interval")) {
+    return false;
+  }
+  if (o.odometry_interval > 0.0 && o.odometry_interval < 0.01) {
+    *error = "mrclam_odometry_interval must be 0 or >= 0.01 s, got " +
+             FormatNumber(o.odometry_interval);
+    return false;
+  }
+  return positive(o.range_sigma, "mrclam_range_sigma") &&
+         positive(o.bearing_sigma, "mrclam_bearing_sigma") &&
+         positive(o.odometry_sigma_xy_floor, "mrclam_odom_sigma_xy_floor") &&
+         non_negative(o.odometry_sigma_xy_per_metre,
+                      "mrclam_odom_sigma_xy_per_m") &&
+         positive(o.odometry_sigma_theta_floor,
+                  "mrclam_odom_sigma_theta_floor") &&
+         non_negative(o.odometry_sigma_theta_per_second,
+                      "mrclam_odom_sigma_theta_per_s") &&
+         non_negative(o.landmark_prior_sigma, "mrclam_landmark_prior_sigma") &&
+         positive(o.first_pose_sigma_xy, "prior_sigma_xy") &&
+         positive(o.first_pose_sigma_theta, "prior_sigma_theta") &&
+         non_negative(o.gt_rate_hz, "gt_rate_hz");
+}
+
+}  // namespace
+
+void IntegrateUnicycle(double v, double omega, double dt, double* x, double* y,
+                       double* theta) {
+  // Chord of the arc: length v * dt * sinc(omega * dt / 2) along the mean
+  // heading; sinc by its series near 0 so that omega -> 0 stays exact.
+  const double half = 0.5 * omega * dt;
+  const double sinc =
+      std::abs(half) < 1e-4 ? 1.0 - half * half / 6.0 : std::sin(half) / half;
+  const double chord = v * dt * sinc;
+  const double mid_heading = *theta + half;
+  *x += chord * std::cos(mid_heading);
+  *y += chord * std::sin(mid_heading);
+  *theta += omega * dt;
+}
+
+bool ConvertMrclam(const std::string& directory, const MrclamOptions& options,
+                   Dataset* dataset, MrclamSummary* summary,
+                   std::string* error) {
+  *dataset = Dataset();
+  *summary = MrclamSummary();
+  if (!CheckOptions(options, error)) return false;
+  const std::string robot =
+      directory + "/Robot" + std::to_string(options.robot);
+  MrclamRaw raw;
+  if (!ReadBarcodes(directory + "/Barcodes.dat", &raw, error) ||
+      !ReadLandmarks(directory + "/Landmark_Groundtruth.dat", &raw, error) ||
+      !ReadOdometry(robot + "_Odometry.dat", &raw, error) ||
+      !ReadGroundTruth(robot + "_Groundtruth.dat", &raw, error) ||
+      !ReadMeasurements(robot + "_Measurement.dat", &raw, error)) {
+    return false;
+  }
+  if (raw.ground_truth.size() < 2) {
+    *error = robot + "_Groundtruth.dat: needs at least 2 rows";
+    return false;
+  }
+  summary->odometry_rows = raw.odometry.size();
+  summary->ground_truth_rows = raw.ground_truth.size();
+  summary->measurement_rows = raw.measurements.size();
+
+  // Poses need velocities before and after them and truth for the prior and
+  // the evaluation: keep measurements inside both time spans.
+  const double span_begin =
+      std::max(raw.odometry.front().t, raw.ground_truth.front().t);
+  const double span_end =
+      std::min(raw.odometry.back().t, raw.ground_truth.back().t);
+  std::vector<RawMeasurement> measurements = raw.measurements;
+  std::stable_sort(measurements.begin(), measurements.end(),
+                   [](const RawMeasurement& a, const RawMeasurement& b) {
+                     return a.t < b.t;
+                   });
+  std::vector<double> measurement_times;
+  std::set<LandmarkId> observed;
+  for (const RawMeasurement& m : measurements) {
+    const auto subject = raw.subject_of_barcode.find(m.barcode);
+    if (subject != raw.subject_of_barcode.end() && subject->second >= 1 &&
+        subject->second <= kLastRobotSubject) {
+      ++summary->dropped_robot;
+      continue;
+    }
+    if (subject == raw.subject_of_barcode.end() ||
+        raw.landmarks.count(subject->second) == 0) {
+      ++summary->dropped_unknown;
+      continue;
+    }
+    if (m.t < span_begin || m.t > span_end) {
+      ++summary->dropped_outside_span;
+      continue;
+    }
+    Observation obs;
+    obs.type = ObservationType::kRangeBearing;
+    obs.t = m.t;
+    obs.id = subject->second;
+    obs.range = m.range;
+    obs.bearing = WrapAngle(m.bearing);
+    obs.sigma_range = options.range_sigma;
+    obs.sigma_bearing = options.bearing_sigma;
+    dataset->observations.push_back(obs);
+    measurement_times.push_back(m.t);
+    observed.insert(obs.id);
+  }
+  summary->measurements_kept = dataset->observations.size();
+  if (dataset->observations.empty()) {
+    *error = robot +
+             "_Measurement.dat: no landmark measurement inside the "
+             "odometry and ground-truth times";
+    return false;
+  }
+
+  const std::vector<double> times =
+      TrajectoryTimes(measurement_times, options.odometry_interval);
+  summary->trajectory_times = times.size();
+  std::size_t row = 0;
+  for (std::size_t k = 0; k + 1 < times.size(); ++k) {
+    Odometry odom;
+    odom.t0 = times[k];
+    odom.t1 = times[k + 1];
+    double path_length;
+    IntegrateBetween(raw.odometry, odom.t0, odom.t1, &row, &odom.dx, &odom.dy,
+                     &odom.dtheta, &path_length);
+    odom.dtheta = WrapAngle(odom.dtheta);
+    odom.sigma_x = odom.sigma_y =
+        std::max(options.odometry_sigma_xy_floor,
+                 options.odometry_sigma_xy_per_metre * path_length);
+    odom.sigma_theta =
+        std::max(options.odometry_sigma_theta_floor,
+                 options.odometry_sigma_theta_per_second * (odom.t1 - odom.t0));
+    dataset->odometry.push_back(odom);
+  }
+
+  dataset->pose_priors.push_back({InterpolatePose(raw.ground_truth, times[0]),
+                                  options.first_pose_sigma_xy,
+                                  options.first_pose_sigma_theta});
+  // Priors only on landmarks this robot sees: an unobserved landmark would
+  // just copy its prior through and flatter the landmark error.
+  for (const auto& [id, xy] : raw.landmarks) {
+    if (options.landmark_prior_sigma > 0.0 && observed.count(id) > 0) {
+      dataset->landmark_priors.push_back(
+          {id, xy.first, xy.second, options.landmark_prior_sigma});
+    }
+    Landmark landmark;
+    landmark.id = id;
+    landmark.x = xy.first;
+    landmark.y = xy.second;
+    dataset->ground_truth_landmarks.push_back(landmark);
+  }
+  const double min_gap =
+      options.gt_rate_hz > 0.0 ? 1.0 / options.gt_rate_hz : 0.0;
+  for (const TimedPose& p : raw.ground_truth) {
+    if (p.t < times.front() || p.t > times.back()) continue;
+    if (!dataset->ground_truth.empty() &&
+        p.t - dataset->ground_truth.back().t < min_gap - 1e-9) {
+      continue;
+    }
+    dataset->ground_truth.push_back({p.t, p.x, p.y, WrapAngle(p.theta)});
+  }
+  summary->ground_truth_kept = dataset->ground_truth.size();
+
+  std::vector<double> range_residuals, bearing_residuals;
+  for (const Observation& obs : dataset->observations) {
+    const TimedPose pose = InterpolatePose(raw.ground_truth, obs.t);
+    const auto& l = raw.landmarks.at(obs.id);
+    range_residuals.push_back(obs.range -
+                              std::hypot(l.first - pose.x, l.second - pose.y));
+    bearing_residuals.push_back(WrapAngle(
+        obs.bearing -
+        (std::atan2(l.second - pose.y, l.first - pose.x) - pose.theta)));
+  }
+  MrclamAgreement& agreement = summary->agreement;
+  agreement.count = range_residuals.size();
+  MedianAndMad(range_residuals, &agreement.range_median, &agreement.range_mad);
+  MedianAndMad(bearing_residuals, &agreement.bearing_median,
+               &agreement.bearing_mad);
+
+  auto n = [](double v) { return FormatNumber(v); };
+  auto& meta = dataset->metadata;
+  meta.emplace_back("source", "UTIAS MRCLAM, directory '" +
+                                  DirectoryName(directory) + "', robot " +
+                                  std::to_string(options.robot) + " (Robot" +
+                                  std::to_string(options.robot) +
+                                  "_*.dat, Barcodes.dat, "
+                                  "Landmark_Groundtruth.dat)");
+  meta.emplace_back("citation",
+                    "Leung, Halpern, Barfoot, Liu, The UTIAS Multi-Robot "
+                    "Cooperative Localization and Mapping Dataset, IJRR "
+                    "30(8), 2011");
+  meta.emplace_back("license",
+                    "no licence file given by the authors; published for "
+                    "research use with the citation; see "
+                    "third_party_licenses/UTIAS_MRCLAM.txt");
+  meta.emplace_back("converter", ConverterDescription(options));
+  meta.emplace_back(
+      "measurements",
+      std::to_string(summary->measurement_rows) + " rows, kept " +
+          std::to_string(summary->measurements_kept) + ", dropped " +
+          std::to_string(summary->dropped_robot) + " of robots, " +
+          std::to_string(summary->dropped_unknown) + " of unknown barcodes, " +
+          std::to_string(summary->dropped_outside_span) +
+          " outside the odometry/ground-truth times");
+  meta.emplace_back(
+      "trajectory",
+      std::to_string(summary->trajectory_times) +
+          " pose times (the distinct measurement times" +
+          (options.odometry_interval > 0.0
+               ? ", and steps of <= " + n(options.odometry_interval) +
+                     " s between them)"
+               : ")") +
+          ", from " + n(times.front()) + " to " + n(times.back()) +
+          " (Unix time); ODOM integrates the commanded velocities exactly");
+  meta.emplace_back(
+      "agreement", "vs Vicon truth over " + std::to_string(agreement.count) +
+                       " measurements: range residual median " +
+                       n(agreement.range_median) + " m, MAD " +
+                       n(agreement.range_mad) + " m; bearing residual median " +
+                       n(agreement.bearing_median) + " rad, MAD " +
+                       n(agreement.bearing_mad) + " rad");
+  return true;
+}
+
+}  // namespace rff

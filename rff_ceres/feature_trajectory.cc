@@ -1,0 +1,124 @@
+#include "rff_ceres/feature_trajectory.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "costs/weight_prior_cost.h"
+
+namespace rff {
+
+std::unique_ptr<FeatureTrajectory> FeatureTrajectory::Create(
+    const FeatureTrajectoryOptions& options,
+    std::shared_ptr<const MeanFunction> mean, double t_begin, double t_end,
+    std::string* error) {
+  if (!(options.segment_length >= 0.0) || !(options.segment_overlap >= 0.0) ||
+      (options.segment_length > 0.0 &&
+       !(options.segment_overlap < options.segment_length))) {
+    *error = "segment length and overlap must be >= 0, with overlap < length";
+    return nullptr;
+  }
+  std::unique_ptr<FeatureTrajectory> model(new FeatureTrajectory);
+  model->mean_ = std::move(mean);
+  model->origin_ = t_begin;
+  // A run with one time still needs a window of positive length.
+  const double length = std::max(t_end - t_begin, 1e-3);
+  model->position_kernel_ = CreateKernel(options.position_kernel, error);
+  if (!model->position_kernel_) return nullptr;
+  model->heading_kernel_ = CreateKernel(options.heading_kernel, error);
+  if (!model->heading_kernel_) return nullptr;
+
+  const int num_segments =
+      options.segment_length > 0.0
+          ? std::max(1, static_cast<int>(
+                            std::ceil(length / options.segment_length - 1e-9)))
+          : 1;
+  const double segment = length / num_segments;
+  model->overlap_ = num_segments > 1 ? options.segment_overlap : 0.0;
+  for (int k = 0; k < num_segments; ++k) {
+    Segment s;
+    s.begin = k * segment;
+    s.end = (k + 1) * segment;
+    FeatureMapOptions map_options;
+    map_options.family = options.family;
+    // Each segment's maps cover its extent and half the overlap each side.
+    map_options.window_begin = s.begin - (k > 0 ? 0.5 * model->overlap_ : 0.0);
+    map_options.window_end =
+        s.end + (k + 1 < num_segments ? 0.5 * model->overlap_ : 0.0);
+    map_options.num_features = options.num_position_features;
+    map_options.seed = options.seed + 2 * k;
+    s.position_map =
+        CreateFeatureMap(*model->position_kernel_, map_options, error);
+    if (!s.position_map) return nullptr;
+    map_options.num_features = options.num_heading_features;
+    map_options.seed = options.seed + 2 * k + 1;  // Independent draws.
+    s.heading_map =
+        CreateFeatureMap(*model->heading_kernel_, map_options, error);
+    if (!s.heading_map) return nullptr;
+    model->weights_.push_back(
+        Eigen::VectorXd::Zero(s.position_map->num_features()));
+    model->weights_.push_back(
+        Eigen::VectorXd::Zero(s.position_map->num_features()));
+    model->weights_.push_back(
+        Eigen::VectorXd::Zero(s.heading_map->num_features()));
+    model->segments_.push_back(std::move(s));
+  }
+  return model;
+}
+
+const std::vector<FeatureTrajectory::Features>& FeatureTrajectory::FeaturesAt(
+    double t) const {
+  auto it = cache_.find(t);
+  if (it != cache_.end()) return it->second;
+  const double tau = t - origin_;
+  const int last = static_cast<int>(segments_.size()) - 1;
+  // The segment whose nominal extent holds tau (clamped at the ends).
+  const double segment = segments_[0].end - segments_[0].begin;
+  const int k =
+      std::clamp(static_cast<int>(std::floor(tau / segment)), 0, last);
+  // (segment, blend weight) pairs active at tau.
+  std::vector<std::pair<int, double>> active;
+  const double half = 0.5 * overlap_;
+  if (k > 0 && tau < segments_[k].begin + half) {
+    const double u = (tau - (segments_[k].begin - half)) / overlap_;
+    active = {{k - 1, std::cos(0.5 * M_PI * u)}, {k, std::sin(0.5 * M_PI * u)}};
+  } else if (k < last && tau > segments_[k].end - half) {
+    const double u = (tau - (segments_[k].end - half)) / overlap_;
+    active = {{k, std::cos(0.5 * M_PI * u)}, {k + 1, std::sin(0.5 * M_PI * u)}};
+  } else {
+    active = {{k, 1.0}};
+  }
+  std::vector<Features> features;
+  for (const auto& [s, weight] : active) {
+    const Segment& seg = segments_[s];
+    auto position =
+        std::make_shared<Eigen::VectorXd>(seg.position_map->num_features());
+    seg.position_map->Evaluate(tau, position->data(), nullptr);
+    *position *= weight;
+    auto heading =
+        std::make_shared<Eigen::VectorXd>(seg.heading_map->num_features());
+    seg.heading_map->Evaluate(tau, heading->data(), nullptr);
+    *heading *= weight;
+    features.push_back({s, position, heading});
+  }
+  return cache_.emplace(t, std::move(features)).first->second;
+}
+
+PoseMap FeatureTrajectory::PoseAt(double t) const {
+  PoseMap map;
+  map.mean = mean_->Evaluate(t);
+  for (const Features& f : FeaturesAt(t)) {
+    map.terms.push_back({3 * f.segment + kX, 0, f.position});
+    map.terms.push_back({3 * f.segment + kY, 1, f.position});
+    map.terms.push_back({3 * f.segment + kTheta, 2, f.heading});
+  }
+  return map;
+}
+
+void FeatureTrajectory::AddPriorCosts(ceres::Problem* problem) {
+  for (int b = 0; b < num_blocks(); ++b) {
+    problem->AddResidualBlock(new WeightPriorCost(block_size(b)), nullptr,
+                              mutable_block(b));
+  }
+}
+
+}  // namespace rff

@@ -1,0 +1,98 @@
+// The weight-space GP trajectory of the paper (eq. 4):
+//
+//   x_k(t) = mu_k(t) + phi_k(t - t_origin)^T b_k,   b_k ~ N(0, I),
+//
+// for k in {x, y, theta}. x and y share one kernel and feature map (with
+// their own weights); the heading has its own. Times are shifted to the
+// start of the run before the features see them: Unix-epoch seconds
+// (~1.2e9) would leave cos(w t) with no significant digits.
+//
+// Windowed weights: with a segment length S > 0 the run is cut into segments,
+// each with its own feature maps and weight blocks, blended across an
+// overlap O around each boundary with weights cos(pi u / 2), sin(pi u / 2)
+// (u from 0 to 1 across the overlap). The squares of the blend weights sum to
+// one, so the prior variance k(0) is kept everywhere, and the reduced system
+// is block-banded: its cost grows linearly with the length of the run.
+#ifndef RFF_CERES_FEATURE_TRAJECTORY_H_
+#define RFF_CERES_FEATURE_TRAJECTORY_H_
+
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "rff_ceres/features/feature_map.h"
+#include "rff_ceres/kernels/kernel.h"
+#include "rff_ceres/mean/mean_function.h"
+#include "rff_ceres/trajectory_model.h"
+
+namespace rff {
+
+struct FeatureTrajectoryOptions {
+  KernelOptions position_kernel;  // x and y
+  KernelOptions heading_kernel;   // theta
+  std::string family = "hilbert";
+  int num_position_features = 100;
+  int num_heading_features = 100;
+  std::uint64_t seed = 1;
+  double segment_length = 0.0;   // Seconds; 0: one global segment.
+  double segment_overlap = 0.0;  // Seconds, < segment_length.
+};
+
+class FeatureTrajectory : public TrajectoryModel {
+ public:
+  // Blocks of segment s are 3 s + {kX, kY, kTheta}.
+  enum Block { kX = 0, kY = 1, kTheta = 2 };
+
+  // The model on the time window [t_begin, t_end] around `mean`. Returns
+  // nullptr and sets `error` on bad options.
+  static std::unique_ptr<FeatureTrajectory> Create(
+      const FeatureTrajectoryOptions& options,
+      std::shared_ptr<const MeanFunction> mean, double t_begin, double t_end,
+      std::string* error);
+
+  int num_blocks() const override { return static_cast<int>(weights_.size()); }
+  int block_size(int block) const override {
+    return static_cast<int>(weights_[block].size());
+  }
+  double* mutable_block(int block) override { return weights_[block].data(); }
+  int num_segments() const { return static_cast<int>(segments_.size()); }
+  PoseMap PoseAt(double t) const override;
+  void AddPriorCosts(ceres::Problem* problem) override;
+
+  double origin() const { return origin_; }
+  const MeanFunction& mean() const { return *mean_; }
+  void set_mean(std::shared_ptr<const MeanFunction> mean) {
+    mean_ = std::move(mean);
+  }
+
+ private:
+  FeatureTrajectory() = default;
+
+  struct Segment {
+    double begin = 0.0;  // Nominal extent, relative to the origin.
+    double end = 0.0;
+    std::unique_ptr<FeatureMap> position_map, heading_map;
+  };
+  // Blend-weighted features of the (one or two) segments active at a time.
+  struct Features {
+    int segment = 0;
+    std::shared_ptr<const Eigen::VectorXd> position;
+    std::shared_ptr<const Eigen::VectorXd> heading;
+  };
+  const std::vector<Features>& FeaturesAt(double t) const;
+
+  std::shared_ptr<const MeanFunction> mean_;
+  std::unique_ptr<Kernel> position_kernel_, heading_kernel_;
+  std::vector<Segment> segments_;
+  double overlap_ = 0.0;
+  double origin_ = 0.0;
+  std::vector<Eigen::VectorXd> weights_;
+  // Observations at the same time share their feature vectors.
+  mutable std::map<double, std::vector<Features>> cache_;
+};
+
+}  // namespace rff
+
+#endif  // RFF_CERES_FEATURE_TRAJECTORY_H_

@@ -1,0 +1,113 @@
+#include "rff_ceres/kernels/kernel.h"
+
+#include <cmath>
+#include <functional>
+#include <sstream>
+
+#include "rff_ceres/kernels/matern_kernel.h"
+#include "rff_ceres/kernels/periodic_kernel.h"
+#include "rff_ceres/kernels/rbf_kernel.h"
+
+namespace rff {
+namespace {
+
+struct KernelEntry {
+  const char* name;
+  std::function<std::unique_ptr<Kernel>(const KernelOptions&)> create;
+};
+
+// The registry: one line per kernel.
+const std::vector<KernelEntry>& Registry() {
+  static const std::vector<KernelEntry> registry = {
+      {"rbf",
+       [](const KernelOptions& o) {
+         return std::make_unique<RbfKernel>(o.variance, o.lengthscale);
+       }},
+      {"matern12",
+       [](const KernelOptions& o) {
+         return std::make_unique<MaternKernel>(1, o.variance, o.lengthscale);
+       }},
+      {"matern32",
+       [](const KernelOptions& o) {
+         return std::make_unique<MaternKernel>(3, o.variance, o.lengthscale);
+       }},
+      {"matern52",
+       [](const KernelOptions& o) {
+         return std::make_unique<MaternKernel>(5, o.variance, o.lengthscale);
+       }},
+      {"periodic",
+       [](const KernelOptions& o) {
+         return std::make_unique<PeriodicKernel>(o.variance, o.lengthscale,
+                                                 o.period);
+       }},
+  };
+  return registry;
+}
+
+std::string JoinedNames() {
+  std::string joined;
+  for (const std::string& name : KernelNames()) {
+    joined += (joined.empty() ? "" : ", ") + name;
+  }
+  return joined;
+}
+
+bool CheckPositive(const char* what, double value, std::string* error) {
+  if (std::isfinite(value) && value > 0.0) return true;
+  std::ostringstream message;
+  message << "kernel " << what << " must be positive and finite, got " << value;
+  *error = message.str();
+  return false;
+}
+
+}  // namespace
+
+double UniformOpen01(std::mt19937_64* rng) {
+  // 53 random bits, offset by half a step: never 0 or 1.
+  return (static_cast<double>((*rng)() >> 11) + 0.5) * 0x1.0p-53;
+}
+
+double Kernel::SampleFrequency(std::mt19937_64* rng) const {
+  return FrequencyQuantile(UniformOpen01(rng));
+}
+
+bool Kernel::FourierSeries(int /*num_terms*/, std::vector<double>* frequencies,
+                           std::vector<double>* coefficients) const {
+  frequencies->clear();
+  coefficients->clear();
+  return false;
+}
+
+std::unique_ptr<Kernel> CreateKernel(const KernelOptions& options,
+                                     std::string* error) {
+  for (const KernelEntry& entry : Registry()) {
+    if (options.name != entry.name) continue;
+    if (!CheckPositive("variance", options.variance, error) ||
+        !CheckPositive("lengthscale", options.lengthscale, error)) {
+      return nullptr;
+    }
+    if (options.name == "periodic") {
+      if (!CheckPositive("period", options.period, error)) return nullptr;
+      // Below this the series needs more than ~12000 terms (white noise).
+      if (options.lengthscale < 1e-3) {
+        std::ostringstream message;
+        message << "periodic kernel lengthscale must be >= 0.001, got "
+                << options.lengthscale;
+        *error = message.str();
+        return nullptr;
+      }
+    }
+    return entry.create(options);
+  }
+  *error =
+      "unknown kernel '" + options.name + "' (known: " + JoinedNames() + ")";
+  return nullptr;
+}
+
+std::vector<std::string> KernelNames() {
+  std::vector<std::string> names;
+  for (const KernelEntry& entry : Registry()) names.push_back(entry.name);
+  return names;
+}
+
+}  // namespace rff

@@ -1,0 +1,81 @@
+// Small SE(2) toolkit: planar poses (x, y, theta) with composition, inverse,
+// relative pose and interpolation. Templated on the scalar so that Ceres cost
+// functors can use the same formulas with Jets; headings stay in (-pi, pi].
+#ifndef RFF_CERES_SE2_H_
+#define RFF_CERES_SE2_H_
+
+#include <cmath>
+
+#include "rff_ceres/io/text_parser.h"
+#include "rff_ceres/types.h"
+
+namespace rff {
+
+template <typename T>
+struct Pose2T {
+  T x = T(0.0);
+  T y = T(0.0);
+  T theta = T(0.0);
+};
+using Pose2 = Pose2T<double>;
+
+// Wraps an angle to (-pi, pi]. The generic form works for Ceres Jets (ceil
+// has a zero derivative, so the wrap does not disturb the gradient).
+template <typename T>
+T NormalizeAngle(const T& angle) {
+  using std::ceil;
+  const T two_pi = T(2.0 * M_PI);
+  return angle - two_pi * ceil((angle - T(M_PI)) / two_pi);
+}
+// For doubles use the exact remainder-based wrap of the readers.
+inline double NormalizeAngle(double angle) { return WrapAngle(angle); }
+
+// a * b: the pose b, given in the frame of a, expressed in a's parent frame.
+template <typename T>
+Pose2T<T> Compose(const Pose2T<T>& a, const Pose2T<T>& b) {
+  using std::cos;
+  using std::sin;
+  const T c = cos(a.theta);
+  const T s = sin(a.theta);
+  return {a.x + c * b.x - s * b.y, a.y + s * b.x + c * b.y,
+          NormalizeAngle(a.theta + b.theta)};
+}
+
+// a^-1, so that Compose(a, Inverse(a)) is the identity.
+template <typename T>
+Pose2T<T> Inverse(const Pose2T<T>& a) {
+  using std::cos;
+  using std::sin;
+  const T c = cos(a.theta);
+  const T s = sin(a.theta);
+  return {-(c * a.x + s * a.y), s * a.x - c * a.y, NormalizeAngle(-a.theta)};
+}
+
+// a^-1 * b: the pose b seen from the frame of a (the form of an ODOM record).
+template <typename T>
+Pose2T<T> Between(const Pose2T<T>& a, const Pose2T<T>& b) {
+  using std::cos;
+  using std::sin;
+  const T c = cos(a.theta);
+  const T s = sin(a.theta);
+  const T dx = b.x - a.x;
+  const T dy = b.y - a.y;
+  return {c * dx + s * dy, -s * dx + c * dy, NormalizeAngle(b.theta - a.theta)};
+}
+
+// Pose at fraction `alpha` from a (0) to b (1): linear in x and y, heading
+// along the shorter arc of the circle (so 179 deg -> -179 deg passes 180 deg).
+template <typename T>
+Pose2T<T> Interpolate(const Pose2T<T>& a, const Pose2T<T>& b, const T& alpha) {
+  return {a.x + alpha * (b.x - a.x), a.y + alpha * (b.y - a.y),
+          NormalizeAngle(a.theta + alpha * NormalizeAngle(b.theta - a.theta))};
+}
+
+inline Pose2 ToPose2(const TimedPose& p) { return {p.x, p.y, p.theta}; }
+inline TimedPose ToTimedPose(double t, const Pose2& p) {
+  return {t, p.x, p.y, p.theta};
+}
+
+}  // namespace rff
+
+#endif  // RFF_CERES_SE2_H_

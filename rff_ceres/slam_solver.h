@@ -1,0 +1,67 @@
+// The whole RFF-SLAM solve: prior mean, feature trajectory, landmark
+// initialisation, the Ceres problem, Levenberg-Marquardt with the landmarks
+// eliminated by Schur complement, and the trajectory queried at the output
+// times. Apps only translate flags into SlamOptions and print the result.
+#ifndef RFF_CERES_SLAM_SOLVER_H_
+#define RFF_CERES_SLAM_SOLVER_H_
+
+#include <string>
+#include <vector>
+
+#include "ceres/solver.h"
+#include "rff_ceres/feature_trajectory.h"
+#include "rff_ceres/slam_problem.h"
+#include "rff_ceres/types.h"
+
+namespace rff {
+
+// Ceres solver settings, named as Ceres names them.
+struct SolverOptions {
+  std::string linear_solver = "DENSE_SCHUR";
+  std::string preconditioner = "auto";  // Or a Ceres preconditioner name.
+  std::string trust_region_strategy = "LEVENBERG_MARQUARDT";
+  int num_threads = 2;
+  int max_iterations = 100;
+  double function_tolerance = 1e-8;
+  double gradient_tolerance = 1e-10;
+  double parameter_tolerance = 1e-8;
+  bool log_progress = false;  // Ceres's per-iteration log (glog INFO).
+};
+
+// Validates `options` and fills the Ceres options from it.
+bool ToCeresOptions(const SolverOptions& options,
+                    ceres::Solver::Options* ceres_options, std::string* error);
+
+struct SlamOptions {
+  std::string prior_mean = "auto";
+  FeatureTrajectoryOptions trajectory;
+  ProblemOptions problem;
+  SolverOptions solver;
+};
+
+struct SlamResult {
+  // Poses at every distinct observation and ground-truth time (the solver
+  // reads the GT times, never the GT poses), headings wrapped.
+  std::vector<TimedPose> trajectory;
+  std::vector<Landmark> landmarks;  // Sorted by id.
+  ceres::Solver::Summary summary;
+  double solve_seconds = 0.0;  // Wall time of the whole RunSlam.
+  bool converged = false;      // Ceres reported CONVERGENCE.
+};
+
+// Runs the solve. Returns false with a message on bad options or input, and
+// when the solve fails or its result is not finite (divergence).
+bool RunSlam(const Dataset& dataset, const SlamOptions& options,
+             SlamResult* result, std::string* error);
+
+// Times at which RunSlam reports the trajectory: every distinct observation
+// and GT_POSE time, or, when there are none, the odometry and prior times.
+std::vector<double> OutputTimes(const Dataset& dataset);
+
+// Writes the summary (options, costs, iterations, times) as JSON.
+bool WriteSummaryJson(const SlamOptions& options, const SlamResult& result,
+                      const std::string& path, std::string* error);
+
+}  // namespace rff
+
+#endif  // RFF_CERES_SLAM_SOLVER_H_

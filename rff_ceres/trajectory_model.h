@@ -1,0 +1,43 @@
+// The continuous-time trajectory as the problem builder sees it: a set of
+// parameter blocks, the affine map from them to the pose at any time, and the
+// prior over them. The weight-space GP (FeatureTrajectory) and the discrete
+// WNOA states are two implementations, so every cost, writer and metric
+// serves both.
+#ifndef RFF_CERES_TRAJECTORY_MODEL_H_
+#define RFF_CERES_TRAJECTORY_MODEL_H_
+
+#include <string>
+#include <vector>
+
+#include "Eigen/Core"
+#include "ceres/problem.h"
+#include "costs/pose_map.h"
+
+namespace rff {
+
+class TrajectoryModel {
+ public:
+  virtual ~TrajectoryModel() = default;
+
+  virtual int num_blocks() const = 0;
+  virtual int block_size(int block) const = 0;
+  virtual double* mutable_block(int block) = 0;
+  const double* block(int block) const {
+    return const_cast<TrajectoryModel*>(this)->mutable_block(block);
+  }
+
+  // pose(t) as an affine function of the blocks; PoseTerm::block indexes the
+  // model's blocks.
+  virtual PoseMap PoseAt(double t) const = 0;
+
+  // Adds the prior over the blocks (whitened weights, GP motion prior).
+  virtual void AddPriorCosts(ceres::Problem* problem) = 0;
+
+  // Heading and position at t with the current block values (heading not
+  // wrapped: the model's heading is a continuous function of time).
+  Eigen::Vector3d Pose(double t) const;
+};
+
+}  // namespace rff
+
+#endif  // RFF_CERES_TRAJECTORY_MODEL_H_

@@ -1,0 +1,392 @@
+#include "rff_ceres/convert/plaza.h"
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "gmock/gmock.h"
+#include "gtest/gtest.h"
+#include "rff_ceres/io/dataset_io.h"
+#include "rff_ceres/io/text_parser.h"
+
+namespace rff {
+namespace {
+
+using ::testing::HasSubstr;
+
+// A fresh directory per test case (ctest runs the cases in parallel).
+std::string TempDir() {
+  const std::string dir =
+      std::string(RFF_BINARY_DIR) + "/test_tmp/plaza_test/" +
+      ::testing::UnitTest::GetInstance()->current_test_info()->name();
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  return dir;
+}
+
+void WriteFile(const std::string& path, const std::string& text) {
+  std::ofstream out(path);
+  out << text;
+}
+
+std::string ReadFile(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  return buffer.str();
+}
+
+// Composes the ODOM increments from the PRIOR_POSE (dead reckoning) and
+// returns the RMS translation error against GT_POSE at the ODOM end times,
+// which are GT times on Plaza.
+double DeadReckoningRms(const Dataset& d) {
+  TimedPose pose = d.pose_priors.at(0).pose;
+  double sum_squares = 0.0;
+  std::size_t gt_index = 1;
+  for (const Odometry& o : d.odometry) {
+    const double c = std::cos(pose.theta), s = std::sin(pose.theta);
+    pose.x += c * o.dx - s * o.dy;
+    pose.y += s * o.dx + c * o.dy;
+    pose.theta += o.dtheta;
+    const TimedPose& truth = d.ground_truth.at(gt_index++);
+    EXPECT_EQ(truth.t, o.t1);
+    sum_squares +=
+        std::pow(pose.x - truth.x, 2) + std::pow(pose.y - truth.y, 2);
+  }
+  return std::sqrt(sum_squares / d.odometry.size());
+}
+
+// The robot drives along x at 1 m/s (heading 0, written unwrapped as 2 pi);
+// beacon 3 sits at (0, 10), beacon 8 at (20, 0). The raw ranges are
+// (r_true - 0.5) / 0.9, so the fit must give a = 0.9, b = 0.5 exactly, except
+// one outlier 30 m long. TD is out of time order.
+constexpr double kA = 0.9;
+constexpr double kB = 0.5;
+
+double RawRange(double t, double bx, double by) {
+  return (std::hypot(bx - t, by) - kB) / kA;
+}
+
+void WriteSmallPlaza(const std::string& dir) {
+  const double two_pi = 2.0 * M_PI;
+  std::ostringstream gt;
+  gt << "# time x y heading\n";
+  for (int k = 0; k <= 4; ++k) {
+    gt << k << " " << k << " 0 " << FormatNumber(two_pi) << "\n";
+  }
+  WriteFile(dir + "/Tiny_GT.txt", gt.str());
+  WriteFile(dir + "/Tiny_DR.txt",
+            "# time d dtheta\n1 1 0\n2 1 0.05\n3 1 -0.1\n4 1 6.4\n");
+  WriteFile(dir + "/Tiny_TL.txt", "3 0 10\n8 20 0\n");
+  std::ostringstream td;
+  const double times[] = {0.5, 1.5, 2.5, 3.5, 1.0, 2.0, 3.0, 0.25};
+  for (const double t : times) {
+    td << FormatNumber(t) << " 2 3 " << FormatNumber(RawRange(t, 0, 10))
+       << "\n";
+    td << FormatNumber(t) << " 2 8 " << FormatNumber(RawRange(t, 20, 0))
+       << "\n";
+  }
+  td << "3.75 2 8 " << FormatNumber(RawRange(3.75, 20, 0) + 30.0) << "\n";
+  td << "5 2 8 10\n";  // After the last GT time: outside the trajectory.
+  WriteFile(dir + "/Tiny_TD.txt", td.str());
+}
+
+TEST(FitLinearRangeCalibrationTest, RecoversLineAndRejectsOutlier) {
+  // truth = 2 * measured + 1 except the last pair.
+  const std::vector<double> measured = {1, 2, 3, 4, 5, 6, 7, 8, 3};
+  const std::vector<double> truth = {3, 5, 7, 9, 11, 13, 15, 17, 20};
+  LinearRangeFit fit;
+  std::string error;
+  ASSERT_TRUE(FitLinearRangeCalibration(measured, truth, 2.0, &fit, &error))
+      << error;
+  EXPECT_NEAR(fit.a, 2.0, 1e-12);
+  EXPECT_NEAR(fit.b, 1.0, 1e-12);
+  EXPECT_NEAR(fit.inlier_sigma, 0.0, 1e-12);
+  EXPECT_EQ(fit.num_inliers, 8u);
+  EXPECT_EQ(fit.inlier, std::vector<bool>({true, true, true, true, true, true,
+                                           true, true, false}));
+}
+
+TEST(FitLinearRangeCalibrationTest, InlierSigmaUsesTwoDegreesOfFreedomLess) {
+  // Residuals +-0.1 about truth = measured: sigma = sqrt(4 * 0.01 / 2).
+  const std::vector<double> measured = {0, 1, 2, 3};
+  const std::vector<double> truth = {0.1, 0.9, 1.9, 3.1};
+  LinearRangeFit fit;
+  std::string error;
+  ASSERT_TRUE(FitLinearRangeCalibration(measured, truth, 2.0, &fit, &error));
+  EXPECT_NEAR(fit.a, 1.0, 1e-12);
+  EXPECT_NEAR(fit.b, 0.0, 1e-12);
+  EXPECT_NEAR(fit.inlier_sigma, std::sqrt(0.04 / 2.0), 1e-12);
+}
+
+TEST(FitLinearRangeCalibrationTest, RejectsDegenerateInput) {
+  LinearRangeFit fit;
+  std::string error;
+  EXPECT_FALSE(FitLinearRangeCalibration({1, 2}, {1, 2}, 2.0, &fit, &error));
+  EXPECT_EQ(error, "range calibration needs at least 3 ranges, got 2");
+  EXPECT_FALSE(
+      FitLinearRangeCalibration({4, 4, 4}, {1, 2, 3}, 2.0, &fit, &error));
+  EXPECT_EQ(error, "range calibration: all measured ranges are equal");
+}
+
+TEST(PlazaConvertTest, SmallInputLinearCalibration) {
+  const std::string dir = TempDir();
+  WriteSmallPlaza(dir);
+  PlazaOptions options;
+  options.name = "Tiny";
+  Dataset d;
+  PlazaSummary s;
+  std::string error;
+  ASSERT_TRUE(ConvertPlaza(dir, options, &d, &s, &error)) << error;
+
+  EXPECT_EQ(s.ground_truth_rows, 5u);
+  EXPECT_EQ(s.odometry_rows, 4u);
+  EXPECT_EQ(s.range_rows, 18u);
+  EXPECT_EQ(s.ranges_out_of_order, 8u);  // 1.0, 2.0, 3.0, 0.25 (2 each).
+  EXPECT_EQ(s.ranges_outside_span, 1u);
+  EXPECT_EQ(s.ranges_rejected, 1u);
+  EXPECT_EQ(s.ranges_kept, 16u);
+  EXPECT_NEAR(s.fit.a, kA, 1e-12);
+  EXPECT_NEAR(s.fit.b, kB, 1e-11);
+  EXPECT_DOUBLE_EQ(s.range_sigma, 0.1);  // Perfect fit: the 0.1 m floor.
+
+  ASSERT_EQ(d.pose_priors.size(), 1u);
+  EXPECT_EQ(d.pose_priors[0].pose.t, 0.0);
+  EXPECT_NEAR(d.pose_priors[0].pose.theta, 0.0, 1e-15);  // 2 pi wrapped.
+  EXPECT_EQ(d.pose_priors[0].sigma_xy, 0.02);
+  EXPECT_EQ(d.pose_priors[0].sigma_theta, 0.01);
+
+  ASSERT_EQ(d.odometry.size(), 4u);
+  EXPECT_EQ(d.odometry[1].t0, 1.0);
+  EXPECT_EQ(d.odometry[1].t1, 2.0);
+  EXPECT_EQ(d.odometry[1].dx, 1.0);
+  EXPECT_EQ(d.odometry[1].dy, 0.0);
+  EXPECT_EQ(d.odometry[1].dtheta, 0.05);
+  EXPECT_EQ(d.odometry[1].sigma_x, 0.05);  // 0.05 per metre over 1 m.
+  EXPECT_EQ(d.odometry[1].sigma_y, 0.05);
+  EXPECT_EQ(d.odometry[1].sigma_theta, 0.005);  // Floor (0.05 * 0.05).
+  EXPECT_NEAR(d.odometry[3].dtheta, 6.4 - 2.0 * M_PI, 1e-12);
+  EXPECT_EQ(d.odometry[3].sigma_theta, 0.05 * WrapAngle(6.4));
+
+  // Sorted by time, corrected, the outlier and the late range gone.
+  ASSERT_EQ(d.observations.size(), 16u);
+  EXPECT_EQ(d.observations[0].t, 0.25);
+  EXPECT_EQ(d.observations[0].id, 3);
+  EXPECT_NEAR(d.observations[0].range, std::hypot(0.25, 10.0), 1e-10);
+  EXPECT_EQ(d.observations[1].id, 8);
+  EXPECT_NEAR(d.observations[1].range, std::hypot(19.75, 0.0), 1e-10);
+  EXPECT_EQ(d.observations.back().t, 3.5);
+  for (const Observation& o : d.observations) {
+    EXPECT_EQ(o.type, ObservationType::kRange);
+    EXPECT_EQ(o.sigma_range, 0.1);
+  }
+
+  ASSERT_EQ(d.ground_truth.size(), 5u);
+  EXPECT_NEAR(d.ground_truth[4].theta, 0.0, 1e-15);
+  ASSERT_EQ(d.landmark_priors.size(), 2u);
+  EXPECT_EQ(d.landmark_priors[1].id, 8);
+  EXPECT_EQ(d.landmark_priors[1].x, 20.0);
+  EXPECT_EQ(d.landmark_priors[1].sigma, 1.0);
+  ASSERT_EQ(d.ground_truth_landmarks.size(), 2u);
+  EXPECT_EQ(d.ground_truth_landmarks[0].y, 10.0);
+
+  // The written file reads back through the strict reader.
+  std::ostringstream out;
+  WriteDataset(d, &out);
+  std::istringstream in(out.str());
+  Dataset back;
+  ASSERT_TRUE(ParseDataset(&in, "tiny.rffd", &back, &error)) << error;
+  EXPECT_EQ(back.observations.size(), 16u);
+  EXPECT_THAT(out.str(), HasSubstr("# calibration: range = a * raw + b"));
+  EXPECT_THAT(out.str(), HasSubstr("kept 16 of 18"));
+}
+
+TEST(PlazaConvertTest, SmallInputWithoutCalibrationKeepsRawRanges) {
+  const std::string dir = TempDir();
+  WriteSmallPlaza(dir);
+  PlazaOptions options;
+  options.name = "Tiny";
+  options.calibration = PlazaCalibration::kNone;
+  options.range_sigma = 2.5;
+  options.landmark_prior_sigma = 0.0;
+  Dataset d;
+  PlazaSummary s;
+  std::string error;
+  ASSERT_TRUE(ConvertPlaza(dir, options, &d, &s, &error)) << error;
+  EXPECT_EQ(s.ranges_rejected, 0u);
+  EXPECT_EQ(s.ranges_kept, 17u);  // The outlier stays; the late one not.
+  ASSERT_EQ(d.observations.size(), 17u);
+  EXPECT_EQ(d.observations[0].range, RawRange(0.25, 0, 10));
+  EXPECT_EQ(d.observations[0].sigma_range, 2.5);
+  EXPECT_TRUE(d.landmark_priors.empty());
+  EXPECT_EQ(d.ground_truth_landmarks.size(), 2u);
+}
+
+TEST(PlazaConvertTest, ParsesCalibrationName) {
+  PlazaCalibration c;
+  std::string error;
+  ASSERT_TRUE(ParsePlazaCalibration("none", &c, &error));
+  EXPECT_EQ(c, PlazaCalibration::kNone);
+  ASSERT_TRUE(ParsePlazaCalibration("linear", &c, &error));
+  EXPECT_EQ(c, PlazaCalibration::kLinear);
+  EXPECT_FALSE(ParsePlazaCalibration("robust", &c, &error));
+  EXPECT_EQ(error, "unknown Plaza calibration 'robust' (use linear or none)");
+}
+
+// Runs the converter on the small input after replacing one file.
+std::string ErrorWith(const std::string& dir, const std::string& file,
+                      const std::string& text) {
+  WriteSmallPlaza(dir);
+  WriteFile(dir + "/" + file, text);
+  PlazaOptions options;
+  options.name = "Tiny";
+  Dataset d;
+  PlazaSummary s;
+  std::string error;
+  EXPECT_FALSE(ConvertPlaza(dir, options, &d, &s, &error));
+  return error;
+}
+
+TEST(PlazaConvertTest, RawFileErrorsNameFileAndLine) {
+  const std::string dir = TempDir();
+  EXPECT_EQ(ErrorWith(dir, "Tiny_GT.txt", "# header\n0 0 0 0\n1 1 zero 0\n"),
+            dir + "/Tiny_GT.txt:3: field 3 'zero' is not a finite number");
+  EXPECT_EQ(ErrorWith(dir, "Tiny_GT.txt", "0 0 0 0\n1 1 0\n"),
+            dir + "/Tiny_GT.txt:2: expected 4 fields, got 3");
+  EXPECT_EQ(ErrorWith(dir, "Tiny_GT.txt", "0 0 0 0\n1 1 0 0\n1 2 0 0\n"),
+            dir + "/Tiny_GT.txt:3: time 1 does not increase (previous row 1)");
+  EXPECT_EQ(ErrorWith(dir, "Tiny_DR.txt", "1 1 0\n2.5 1 0\n"),
+            dir +
+                "/Tiny_DR.txt:2: time 2.5 does not match ground-truth row "
+                "3 time 2 (DR row k moves GT pose k to k + 1)");
+  EXPECT_EQ(ErrorWith(dir, "Tiny_DR.txt", "1 1 0\n2 1 0\n"),
+            dir +
+                "/Tiny_DR.txt: 2 rows, expected 4 (one per ground-truth "
+                "row after the first)");
+  EXPECT_EQ(ErrorWith(dir, "Tiny_TD.txt", "0.5 2 3 10\n0.7 2 4 10\n"),
+            dir +
+                "/Tiny_TD.txt:2: beacon 4 is not in the beacon list (TL "
+                "file)");
+  EXPECT_EQ(ErrorWith(dir, "Tiny_TD.txt", "0.5 2 3 -1\n"),
+            dir + "/Tiny_TD.txt:1: range must be >= 0, got -1");
+  EXPECT_EQ(ErrorWith(dir, "Tiny_TD.txt", "0.5 2 -3 1\n"),
+            dir +
+                "/Tiny_TD.txt:1: field 3 '-3' is not a non-negative "
+                "integer");
+  EXPECT_EQ(ErrorWith(dir, "Tiny_TL.txt", "3 0 10\n3 1 1\n"),
+            dir + "/Tiny_TL.txt:2: duplicate beacon 3");
+  EXPECT_EQ(ErrorWith(dir, "Tiny_TL.txt", "# nothing\n"),
+            dir + "/Tiny_TL.txt: no data rows");
+}
+
+TEST(PlazaConvertTest, MissingFileIsAClearError) {
+  const std::string dir = TempDir();
+  WriteSmallPlaza(dir);
+  std::filesystem::remove(dir + "/Tiny_TD.txt");
+  PlazaOptions options;
+  options.name = "Tiny";
+  Dataset d;
+  PlazaSummary s;
+  std::string error;
+  EXPECT_FALSE(ConvertPlaza(dir, options, &d, &s, &error));
+  EXPECT_EQ(error, dir +
+                       "/Tiny_TD.txt: cannot open for reading: No such file "
+                       "or directory");
+}
+
+TEST(PlazaConvertTest, RejectsBadOptions) {
+  PlazaOptions options;
+  options.odometry_sigma_xy_floor = 0.0;
+  Dataset d;
+  PlazaSummary s;
+  std::string error;
+  EXPECT_FALSE(ConvertPlaza("/nonexistent", options, &d, &s, &error));
+  EXPECT_EQ(error, "plaza_odom_sigma_xy_floor must be > 0, got 0");
+}
+
+TEST(PlazaBundledTest, CountsFirstRecordsAndDeadReckoning) {
+  const std::string path = std::string(RFF_SOURCE_DIR) + "/data/plaza1.rffd";
+  Dataset d;
+  std::string error;
+  ASSERT_TRUE(ReadDataset(path, &d, &error)) << error;
+  EXPECT_EQ(d.pose_priors.size(), 1u);
+  EXPECT_EQ(d.landmark_priors.size(), 4u);
+  EXPECT_EQ(d.odometry.size(), 9657u);
+  EXPECT_EQ(d.observations.size(), 3529u);
+  EXPECT_EQ(d.ground_truth.size(), 9658u);
+  EXPECT_EQ(d.ground_truth_landmarks.size(), 4u);
+
+  // First records, as in the raw files (GT row 0, DR row 0, beacon 0).
+  EXPECT_EQ(d.pose_priors[0].pose.t, 3856.857346);
+  EXPECT_EQ(d.pose_priors[0].pose.x, 0.0);
+  EXPECT_NEAR(d.pose_priors[0].pose.theta, 4.222432 - 2.0 * M_PI, 1e-15);
+  EXPECT_EQ(d.odometry[0].t0, 3856.857346);
+  EXPECT_EQ(d.odometry[0].t1, 3857.053202);
+  EXPECT_EQ(d.odometry[0].dx, 0.0002348385815);
+  EXPECT_EQ(d.odometry[0].dy, 0.0);
+  EXPECT_EQ(d.odometry[0].dtheta, -5.2e-05);
+  EXPECT_EQ(d.landmark_priors[0].id, 0);
+  EXPECT_EQ(d.landmark_priors[0].x, -46.623234);
+  EXPECT_EQ(d.landmark_priors[0].sigma, 1.0);
+
+  // Calibration: the published a ~ 0.934, b ~ 0.02 m, sigma ~ 0.5 m; the
+  // first range (TD row 1: beacon 5, 65.46600784 m) corrected with it.
+  double a = 0.0, b = 0.0;
+  for (const auto& [key, value] : d.metadata) {
+    if (key != "calibration") continue;
+    EXPECT_THAT(value, HasSubstr("kept 3529 of 3529"));
+    const std::size_t at_a = value.find("a=");
+    const std::size_t at_b = value.find("b=");
+    ASSERT_NE(at_a, std::string::npos);
+    ASSERT_NE(at_b, std::string::npos);
+    a = std::stod(value.substr(at_a + 2));
+    b = std::stod(value.substr(at_b + 2));
+  }
+  EXPECT_NEAR(a, 0.934, 0.001);
+  EXPECT_NEAR(b, 0.02, 0.005);
+  EXPECT_EQ(d.observations[0].t, 3858.062);
+  EXPECT_EQ(d.observations[0].id, 5);
+  EXPECT_NEAR(d.observations[0].range, a * 65.46600784 + b, 1e-9);
+  EXPECT_EQ(d.observations[0].sigma_range, 0.5);
+
+  // Dead reckoning from the prior ends up ~2 m RMS from the truth.
+  const double rms = DeadReckoningRms(d);
+  EXPECT_NEAR(rms, 1.97, 0.01);
+}
+
+TEST(PlazaSharedTest, RawDataConvertsToTheBundledFile) {
+  const std::string raw = std::string(RFF_SHARED_DIR) + "/data/plaza1";
+  if (!std::filesystem::exists(raw + "/Plaza1_GT.txt")) {
+    GTEST_SKIP() << "no raw Plaza1 data in " << raw;
+  }
+  Dataset d;
+  PlazaSummary s;
+  std::string error;
+  ASSERT_TRUE(ConvertPlaza(raw, PlazaOptions(), &d, &s, &error)) << error;
+  EXPECT_EQ(s.range_rows, 3529u);
+  EXPECT_EQ(s.ranges_out_of_order, 217u);
+  EXPECT_EQ(s.ranges_outside_span, 0u);
+  EXPECT_NEAR(s.fit.a, 0.934, 0.001);
+  EXPECT_NEAR(s.fit.b, 0.018, 0.001);
+  EXPECT_NEAR(s.fit.inlier_sigma, 0.505, 0.001);
+  EXPECT_EQ(s.range_sigma, 0.5);
+  std::ostringstream out;
+  WriteDataset(d, &out);
+  EXPECT_TRUE(out.str() ==
+              ReadFile(std::string(RFF_SOURCE_DIR) + "/data/plaza1.rffd"))
+      << "data/plaza1.rffd is stale: regenerate it (docs/converters.md)";
+
+  // A tighter threshold does reject ranges (gpslam's 2 m keeps them all).
+  PlazaOptions tight;
+  tight.outlier_threshold = 1.0;
+  ASSERT_TRUE(ConvertPlaza(raw, tight, &d, &s, &error)) << error;
+  EXPECT_EQ(s.ranges_rejected, 184u);
+  EXPECT_EQ(s.ranges_kept, 3345u);
+  EXPECT_NEAR(s.fit.a, 0.934, 0.001);
+  EXPECT_NEAR(s.fit.inlier_sigma, 0.437, 0.001);
+}
+
+}  // namespace
+}  // namespace rff

@@ -1,0 +1,184 @@
+#include "rff_ceres/slam_solver.h"
+
+#include <algorithm>
+
+#include "gmock/gmock.h"
+#include "gtest/gtest.h"
+#include "rff_ceres/metrics.h"
+#include "rff_ceres/simulate.h"
+
+namespace rff {
+namespace {
+
+using ::testing::HasSubstr;
+
+// Options that work on the paper's simulated protocol (300 s, 1 Hz).
+SlamOptions PaperSolverOptions() {
+  SlamOptions options;
+  FeatureTrajectoryOptions& t = options.trajectory;
+  t.position_kernel.name = "rbf";
+  t.position_kernel.lengthscale = 5.0;
+  t.position_kernel.variance = 100.0;
+  t.heading_kernel = t.position_kernel;
+  t.heading_kernel.variance = 0.25;
+  t.family = "hilbert";
+  t.num_position_features = 24;
+  t.num_heading_features = 24;
+  t.segment_length = 50.0;
+  t.segment_overlap = 15.0;
+  options.solver.linear_solver = "SPARSE_NORMAL_CHOLESKY";
+  options.solver.num_threads = 1;
+  return options;
+}
+
+double ApeTranslation(const Dataset& dataset, const SlamResult& result) {
+  Evaluation evaluation;
+  std::string error;
+  EXPECT_TRUE(Evaluate(dataset.ground_truth, dataset.ground_truth_landmarks,
+                       result.trajectory, &result.landmarks,
+                       EvaluationOptions(), &evaluation, &error))
+      << error;
+  return evaluation.ape_translation.rms;
+}
+
+TEST(SlamSolverTest, RangeBearingWithOdometryBeatsDeadReckoningByFar) {
+  std::vector<double> errors;
+  for (std::uint64_t seed = 11; seed <= 13; ++seed) {
+    SimulationOptions sim = PaperOptions(seed);
+    sim.num_landmarks = 20;
+    Dataset dataset;
+    std::string error;
+    ASSERT_TRUE(Simulate(sim, &dataset, &error)) << error;
+    SlamResult result;
+    ASSERT_TRUE(RunSlam(dataset, PaperSolverOptions(), &result, &error))
+        << error;
+    EXPECT_TRUE(result.converged);
+    errors.push_back(ApeTranslation(dataset, result));
+  }
+  std::sort(errors.begin(), errors.end());
+  // The bar for sigma_r = 1 m, sigma_b = 2 deg with odometry.
+  EXPECT_LT(errors[1], 0.6)
+      << errors[0] << " " << errors[1] << " " << errors[2];
+}
+
+TEST(SlamSolverTest, NoiseFreeDataIsRecovered) {
+  SimulationOptions sim = PaperOptions(21);
+  sim.num_steps = 120;
+  sim.num_landmarks = 15;
+  sim.noise_free = true;
+  sim.sigma_range = 1e-3;
+  sim.sigma_bearing = 1e-4;
+  Dataset dataset;
+  std::string error;
+  ASSERT_TRUE(Simulate(sim, &dataset, &error)) << error;
+  SlamResult result;
+  ASSERT_TRUE(RunSlam(dataset, PaperSolverOptions(), &result, &error)) << error;
+  // Relative to the size of the scene (the landmarks' spread).
+  double extent = 0.0;
+  for (const Landmark& l : dataset.ground_truth_landmarks) {
+    extent = std::max(extent, std::hypot(l.x, l.y));
+  }
+  EXPECT_LT(ApeTranslation(dataset, result) / extent, 1e-3);
+  for (const Landmark& truth : dataset.ground_truth_landmarks) {
+    const auto it =
+        std::find_if(result.landmarks.begin(), result.landmarks.end(),
+                     [&](const Landmark& l) { return l.id == truth.id; });
+    ASSERT_NE(it, result.landmarks.end());
+    EXPECT_LT(std::hypot(it->x - truth.x, it->y - truth.y) / extent, 1e-3)
+        << "landmark " << truth.id;
+  }
+}
+
+TEST(SlamSolverTest, OutputsEveryObservationAndGroundTruthTimeOnce) {
+  SimulationOptions sim = PaperOptions(3);
+  sim.num_steps = 40;
+  Dataset dataset;
+  std::string error;
+  ASSERT_TRUE(Simulate(sim, &dataset, &error)) << error;
+  dataset.ground_truth.push_back({0.5, 0, 0, 0});  // An extra query time.
+  SlamResult result;
+  ASSERT_TRUE(RunSlam(dataset, PaperSolverOptions(), &result, &error)) << error;
+  ASSERT_EQ(result.trajectory.size(), 41u);
+  for (std::size_t i = 1; i < result.trajectory.size(); ++i) {
+    EXPECT_LT(result.trajectory[i - 1].t, result.trajectory[i].t);
+  }
+}
+
+struct BadOption {
+  const char* name;
+  void (*apply)(SlamOptions*);
+  const char* message;
+};
+
+class SlamSolverOptionTest : public ::testing::TestWithParam<BadOption> {};
+
+TEST_P(SlamSolverOptionTest, IsRejectedWithAMessage) {
+  SimulationOptions sim = PaperOptions(4);
+  sim.num_steps = 20;
+  Dataset dataset;
+  std::string error;
+  ASSERT_TRUE(Simulate(sim, &dataset, &error)) << error;
+  SlamOptions options = PaperSolverOptions();
+  GetParam().apply(&options);
+  SlamResult result;
+  EXPECT_FALSE(RunSlam(dataset, options, &result, &error));
+  EXPECT_THAT(error, HasSubstr(GetParam().message));
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    BadOptions, SlamSolverOptionTest,
+    ::testing::Values(
+        BadOption{
+            "UnknownKernel",
+            [](SlamOptions* o) { o->trajectory.position_kernel.name = "sinc"; },
+            "sinc"},
+        BadOption{"ZeroLengthscale",
+                  [](SlamOptions* o) {
+                    o->trajectory.position_kernel.lengthscale = 0.0;
+                  },
+                  "lengthscale"},
+        BadOption{"UnknownFamily",
+                  [](SlamOptions* o) { o->trajectory.family = "wavelet"; },
+                  "wavelet"},
+        BadOption{
+            "NegativeFeatures",
+            [](SlamOptions* o) { o->trajectory.num_position_features = -3; },
+            "-3"},
+        BadOption{"UnknownLinearSolver",
+                  [](SlamOptions* o) { o->solver.linear_solver = "MAGIC"; },
+                  "unknown linear solver 'MAGIC'"},
+        BadOption{"CgnrWithSchurPreconditioner",
+                  [](SlamOptions* o) {
+                    o->solver.linear_solver = "CGNR";
+                    o->solver.preconditioner = "SCHUR_JACOBI";
+                  },
+                  "CGNR supports the preconditioners IDENTITY and JACOBI"},
+        BadOption{"UnknownLoss",
+                  [](SlamOptions* o) { o->problem.loss.name = "tukey"; },
+                  "unknown loss 'tukey'"},
+        BadOption{"OverlapLongerThanSegment",
+                  [](SlamOptions* o) { o->trajectory.segment_overlap = 60.0; },
+                  "overlap < length"},
+        BadOption{"UnknownPriorMean",
+                  [](SlamOptions* o) { o->prior_mean = "psychic"; },
+                  "unknown prior mean 'psychic'"}),
+    [](const ::testing::TestParamInfo<BadOption>& info) {
+      return std::string(info.param.name);
+    });
+
+TEST(SlamSolverTest, OdometryMeanWithoutOdometryIsAnError) {
+  SimulationOptions sim = PaperOptions(5);
+  sim.num_steps = 20;
+  sim.odometry = false;
+  Dataset dataset;
+  std::string error;
+  ASSERT_TRUE(Simulate(sim, &dataset, &error)) << error;
+  SlamOptions options = PaperSolverOptions();
+  options.prior_mean = "odometry";
+  SlamResult result;
+  EXPECT_FALSE(RunSlam(dataset, options, &result, &error));
+  EXPECT_THAT(error, HasSubstr("prior mean 'odometry'"));
+}
+
+}  // namespace
+}  // namespace rff
