@@ -618,10 +618,9 @@ bool Simulate(const SimulationOptions& options, Dataset* dataset,
           break;
       }
       if (observation.HasRange()) {
-        // A range cannot be negative: draws below zero are reflected, which
-        // only happens within a few sigma of the landmark.
-        observation.range =
-            std::abs(std::sqrt(dx * dx + dy * dy) + range_noise);
+        // Plain Gaussian noise: near a landmark the measured range may be
+        // negative, as in the shared benchmark sets (the format allows it).
+        observation.range = std::sqrt(dx * dx + dy * dy) + range_noise;
         observation.sigma_range = options.sigma_range;
       }
       if (observation.HasBearing()) {

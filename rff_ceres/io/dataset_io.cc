@@ -175,11 +175,10 @@ class DatasetParser {
       obs.sigma_range = v[2];
       obs.sigma_bearing = v[3];
     }
-    if (obs.HasRange()) {
-      if (obs.range < 0.0) {
-        return Fail("range must be >= 0, got " + FormatNumber(obs.range));
-      }
-      if (!Positive(obs.sigma_range, "sigma_range")) return false;
+    // A noisy range may be negative (a Gaussian measurement of a short
+    // distance): it is data, not an error.
+    if (obs.HasRange() && !Positive(obs.sigma_range, "sigma_range")) {
+      return false;
     }
     if (obs.HasBearing() && !Positive(obs.sigma_bearing, "sigma_bearing")) {
       return false;

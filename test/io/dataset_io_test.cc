@@ -124,7 +124,6 @@ const BadCase kBadCases[] = {
      ":2: ODOM needs t1 > t0"},
     {"OdometryZeroLength", "RFFD 1\nODOM 1 1 0 0 0 1 1 1\n",
      ":2: ODOM needs t1 > t0"},
-    {"NegativeRange", "RFFD 1\nRANGE 1 2 -3 1\n", ":2: range must be >= 0"},
     {"NegativeId", "RFFD 1\nRANGE 1 -2 3 1\n",
      ":2: landmark id '-2' is not a non-negative"},
     {"FractionalId", "RFFD 1\nRANGE 1 2.5 3 1\n", "landmark id '2.5'"},
@@ -173,6 +172,15 @@ TEST(DatasetIoTest, ObservationOfLandmarkWithoutPriorIsFine) {
   EXPECT_TRUE(Parse(std::string(kHead) + "RANGE 1 42 3 1\n", &d, &error))
       << error;
   EXPECT_TRUE(d.landmark_priors.empty());
+}
+
+TEST(DatasetIoTest, NegativeNoisyRangeIsData) {
+  // Gaussian noise on a short distance can give a negative range.
+  Dataset d;
+  std::string error;
+  ASSERT_TRUE(Parse(std::string(kHead) + "RANGE 1 42 -0.25 1\n", &d, &error))
+      << error;
+  EXPECT_EQ(d.observations[0].range, -0.25);
 }
 
 TEST(DatasetIoTest, MissingFileNamesThePath) {

@@ -1,0 +1,94 @@
+// The "localization" prior mean, for data without odometry (and as a
+// drift-free start with it): the robot is localised at each observation
+// time against the PRIOR_LANDMARK means, the fixes are smoothed robustly in
+// time, and the heading comes from the measurements or, for range-only
+// data, from the direction of motion (paper section III-B). See
+// docs/prior_means.md.
+#ifndef RFF_CERES_MEAN_LOCALIZATION_MEAN_H_
+#define RFF_CERES_MEAN_LOCALIZATION_MEAN_H_
+
+#include <functional>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "Eigen/Core"
+#include "rff_ceres/mean/mean_function.h"
+#include "rff_ceres/types.h"
+
+namespace rff {
+
+// A landmark position known to the localiser and its standard deviation.
+struct KnownLandmark {
+  Eigen::Vector2d position = Eigen::Vector2d::Zero();
+  double sigma = 0.0;
+};
+
+// One localisation: pose at time t and its covariance (x, y, theta). When the
+// measurements carry no heading (range-only), has_heading is false and the
+// heading is that of the seed.
+struct PoseFix {
+  TimedPose pose;
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();
+  bool has_heading = false;
+  // Whitened residual sum of squares and its degrees of freedom (0 when the
+  // measurements just determine the pose, so nothing checks it).
+  double chi2 = 0.0;
+  int dof = 0;
+};
+
+// Localises the robot at one time from `observations` (all at that time) of
+// landmarks in `landmarks` (others are ignored): Gauss-Newton on
+// (x, y, theta), or (x, y) for range-only, started from every pose in
+// `seeds`, keeping the lowest cost. The landmark sigma is added to the
+// measurement noise (sigma_r^2 + s^2; sigma_b^2 + (s / r)^2). With
+// `fixed_heading` (range-bearing from one landmark) the heading is held at
+// that value. Returns false when the measurements do not determine the pose
+// (fewer equations than unknowns, or a degenerate geometry) or when no
+// start converges.
+bool LocalizePose(const std::vector<Observation>& observations,
+                  const std::map<LandmarkId, KnownLandmark>& landmarks,
+                  const std::vector<Eigen::Vector3d>& seeds,
+                  const double* fixed_heading, PoseFix* fix);
+
+struct LocalizationOptions {
+  // Acceleration noise density q (m^2/s^3) of the position smoother: the
+  // spline minimises sum (fix - f)^2 / var + (1 / q) int f''^2. Larger
+  // follows the fixes more closely.
+  double position_smoothing = 0.05;
+  // The same for the heading (rad^2/s^3), when the fixes carry it.
+  double heading_smoothing = 0.005;
+  // With odometry: the smoother of the correction (fix - dead reckoning),
+  // which drifts slowly.
+  double correction_smoothing = 1e-4;
+  // A fix whose chi^2 per degree of freedom exceeds this is discarded.
+  double max_chi2_per_dof = 9.0;
+  // Robust smoothing: iterations of reweighting (Cauchy weights at this
+  // many standard deviations of the fix).
+  int robust_iterations = 5;
+  double robust_scale = 2.0;
+  // Fuse ODOM when the dataset has it: the mean is dead reckoning plus the
+  // smoothed correction towards the fixes.
+  bool use_odometry = true;
+};
+
+// What the localiser did, for reports and tests.
+struct LocalizationReport {
+  int times = 0;         // Distinct observation times.
+  int localized = 0;     // Fixes kept.
+  int rejected = 0;      // Fixes discarded by the residual check.
+  bool heading_from_velocity = false;
+  bool fused_odometry = false;
+  std::vector<PoseFix> fixes;  // The kept fixes, in time order.
+};
+
+// Builds the mean. Fails with a clear message when the dataset has no
+// landmark priors, or when no time can be localised.
+std::shared_ptr<const MeanFunction> BuildLocalizationMean(
+    const Dataset& dataset, const LocalizationOptions& options,
+    LocalizationReport* report, std::string* error);
+
+}  // namespace rff
+
+#endif  // RFF_CERES_MEAN_LOCALIZATION_MEAN_H_
