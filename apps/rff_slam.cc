@@ -57,6 +57,11 @@ DEFINE_string(loss, "none",
               "Robust loss on observations: none, huber, cauchy.");
 DEFINE_double(loss_scale, 1.0, "Robust loss scale, in sigmas.");
 DEFINE_bool(use_odometry, true, "Add the ODOM records as residuals.");
+DEFINE_bool(preintegrate_odometry, true,
+            "Compose ODOM chains between observation times into one residual "
+            "each (first-order covariance).");
+DEFINE_double(max_preintegration_seconds, 1.0,
+              "Longest time one preintegrated odometry chain may span.");
 
 // Ceres.
 DEFINE_string(linear_solver, "DENSE_SCHUR",
@@ -107,6 +112,8 @@ rff::SlamOptions OptionsFromFlags() {
   options.problem.loss.name = FLAGS_loss;
   options.problem.loss.scale = FLAGS_loss_scale;
   options.problem.use_odometry = FLAGS_use_odometry;
+  options.problem.preintegrate_odometry = FLAGS_preintegrate_odometry;
+  options.problem.max_preintegration_seconds = FLAGS_max_preintegration_seconds;
   rff::SolverOptions& s = options.solver;
   s.linear_solver = FLAGS_linear_solver;
   s.preconditioner = FLAGS_preconditioner;

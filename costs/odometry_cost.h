@@ -2,10 +2,11 @@
 // the pose at t0 (the ODOM record):
 //
 //   [dx^, dy^] = R(theta0)^T (p1 - p0),   dtheta^ = theta1 - theta0,
-//   r = [ (dx^ - dx) / sigma_x, (dy^ - dy) / sigma_y,
-//         wrap(dtheta^ - dtheta) / sigma_theta ].
+//   r = L [ dx^ - dx, dy^ - dy, wrap(dtheta^ - dtheta) ],
 //
-// Both poses come through their pose maps (they usually share weight blocks).
+// with L the square-root information (diag(1/sigma) for one ODOM record, a
+// full matrix for a preintegrated chain). Both poses come through their pose
+// maps (they usually share weight blocks).
 #ifndef RFF_COSTS_ODOMETRY_COST_H_
 #define RFF_COSTS_ODOMETRY_COST_H_
 
@@ -19,10 +20,15 @@ namespace rff {
 class OdometryCost : public PoseCost<3, 2, false> {
  public:
   OdometryCost(PoseMap map0, PoseMap map1, const Eigen::Vector3d& motion,
-               const Eigen::Vector3d& sigma)
+               const Eigen::Matrix3d& sqrt_information)
       : PoseCost({std::move(map0), std::move(map1)}),
         motion_(motion),
-        inv_sigma_(sigma.cwiseInverse()) {}
+        sqrt_information_(sqrt_information) {}
+  // Independent noise per component (one ODOM record).
+  OdometryCost(PoseMap map0, PoseMap map1, const Eigen::Vector3d& motion,
+               const Eigen::Vector3d& sigma)
+      : OdometryCost(std::move(map0), std::move(map1), motion,
+                     Eigen::Matrix3d(sigma.cwiseInverse().asDiagonal())) {}
 
  protected:
   bool Residual(const std::array<Eigen::Vector3d, 2>& poses,
@@ -34,24 +40,24 @@ class OdometryCost : public PoseCost<3, 2, false> {
     const Eigen::Vector2d d = poses[1].head<2>() - poses[0].head<2>();
     const double dx = c * d.x() + s * d.y();
     const double dy = -s * d.x() + c * d.y();
-    (*r)(0) = (dx - motion_.x()) * inv_sigma_.x();
-    (*r)(1) = (dy - motion_.y()) * inv_sigma_.y();
-    (*r)(2) = WrapAngleResidual(poses[1].z() - poses[0].z() - motion_.z()) *
-              inv_sigma_.z();
+    const Eigen::Vector3d error(
+        dx - motion_.x(), dy - motion_.y(),
+        WrapAngleResidual(poses[1].z() - poses[0].z() - motion_.z()));
+    *r = sqrt_information_ * error;
     if (dr_dposes == nullptr) return true;
     // d(dx, dy)/d p1 = R^T, d/d p0 = -R^T, d/d theta0 = (dy, -dx).
     PoseGradient& j0 = (*dr_dposes)[0];
     PoseGradient& j1 = (*dr_dposes)[1];
     j1 << c, s, 0.0, -s, c, 0.0, 0.0, 0.0, 1.0;
     j0 << -c, -s, dy, s, -c, -dx, 0.0, 0.0, -1.0;
-    j0 = inv_sigma_.asDiagonal() * j0;
-    j1 = inv_sigma_.asDiagonal() * j1;
+    j0 = sqrt_information_ * j0;
+    j1 = sqrt_information_ * j1;
     return true;
   }
 
  private:
   Eigen::Vector3d motion_;
-  Eigen::Vector3d inv_sigma_;
+  Eigen::Matrix3d sqrt_information_;
 };
 
 }  // namespace rff

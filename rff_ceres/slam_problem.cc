@@ -1,11 +1,14 @@
 #include "rff_ceres/slam_problem.h"
 
+#include <algorithm>
+
 #include "costs/bearing_cost.h"
 #include "costs/landmark_prior_cost.h"
 #include "costs/odometry_cost.h"
 #include "costs/pose_prior_cost.h"
 #include "costs/range_bearing_cost.h"
 #include "costs/range_cost.h"
+#include "rff_ceres/odometry_preintegration.h"
 
 namespace rff {
 
@@ -110,15 +113,25 @@ bool SlamProblem::Build(const Dataset& dataset,
         landmarks_.at(p.id).data());
   }
   if (options_.use_odometry) {
-    for (const Odometry& o : dataset.odometry) {
+    // Chains end at every time a pose is needed; without preintegration,
+    // at every record (each record is a chain of its own).
+    std::vector<double> keep_times;
+    for (const Observation& o : dataset.observations) keep_times.push_back(o.t);
+    for (const PosePrior& p : dataset.pose_priors)
+      keep_times.push_back(p.pose.t);
+    if (!options_.preintegrate_odometry) {
+      for (const Odometry& o : dataset.odometry) keep_times.push_back(o.t0);
+    }
+    std::sort(keep_times.begin(), keep_times.end());
+    for (const PreintegratedOdometry& o :
+         PreintegrateOdometry(dataset.odometry, keep_times,
+                              options_.max_preintegration_seconds)) {
       PoseMap map0 = model_->PoseAt(o.t0);
       PoseMap map1 = model_->PoseAt(o.t1);
       const std::vector<double*> blocks = LocalBlocks({&map0, &map1}, nullptr);
       problem_->AddResidualBlock(
-          new OdometryCost(
-              std::move(map0), std::move(map1),
-              Eigen::Vector3d(o.dx, o.dy, o.dtheta),
-              Eigen::Vector3d(o.sigma_x, o.sigma_y, o.sigma_theta)),
+          new OdometryCost(std::move(map0), std::move(map1), o.motion,
+                           SqrtInformation(o.covariance)),
           nullptr, blocks);
     }
   }

@@ -35,6 +35,10 @@ bool CreateLoss(const LossOptions& options,
 struct ProblemOptions {
   LossOptions loss;
   bool use_odometry = true;
+  // Compose ODOM chains between observation times into one residual each
+  // (see odometry_preintegration.h).
+  bool preintegrate_odometry = true;
+  double max_preintegration_seconds = 1.0;
 };
 
 class SlamProblem {

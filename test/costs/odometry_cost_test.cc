@@ -10,16 +10,20 @@ using testing::Wrap;
 
 struct OdometryAutoDiff {
   PoseMap map0, map1;
-  Eigen::Vector3d motion, sigma;
+  Eigen::Vector3d motion;
+  Eigen::Matrix3d sqrt_information;
   template <typename T>
   bool operator()(T const* const* p, T* r) const {
     const auto p0 = PoseOf(map0, p);
     const auto p1 = PoseOf(map1, p);
     const T c = cos(p0[2]), s = sin(p0[2]);
     const T dx = p1[0] - p0[0], dy = p1[1] - p0[1];
-    r[0] = (c * dx + s * dy - motion.x()) / sigma.x();
-    r[1] = (-s * dx + c * dy - motion.y()) / sigma.y();
-    r[2] = Wrap(T(p1[2] - p0[2] - motion.z())) / sigma.z();
+    const T e[3] = {c * dx + s * dy - motion.x(), -s * dx + c * dy - motion.y(),
+                    Wrap(T(p1[2] - p0[2] - motion.z()))};
+    for (int i = 0; i < 3; ++i) {
+      r[i] = T(0.0);
+      for (int k = 0; k < 3; ++k) r[i] += sqrt_information(i, k) * e[k];
+    }
     return true;
   }
 };
@@ -35,10 +39,30 @@ TEST(OdometryCostTest, AnalyticJacobianMatchesAutoDiff) {
     const Eigen::Vector3d sigma(0.05, 0.1, 0.01);
     const OdometryCost cost(map0, map1, motion, sigma);
     auto autodiff = testing::MakeAutoDiff(
-        new OdometryAutoDiff{map0, map1, motion, sigma}, cost);
+        new OdometryAutoDiff{
+            map0, map1, motion,
+            Eigen::Matrix3d(sigma.cwiseInverse().asDiagonal())},
+        cost);
     auto parameters =
         testing::RandomParameters(cost.parameter_block_sizes(), &rng);
     testing::ExpectSameCost(cost, *autodiff, parameters);
+  }
+}
+
+TEST(OdometryCostTest, FullSquareRootInformationMatchesAutoDiff) {
+  std::mt19937 rng(14);
+  Eigen::Matrix3d sqrt_information;
+  sqrt_information << 20.0, 3.0, -1.0, 0.0, 15.0, 2.0, 0.0, 0.0, 90.0;
+  for (int trial = 0; trial < 10; ++trial) {
+    const PoseMap map0 = testing::RandomPoseMap(&rng);
+    const PoseMap map1 = testing::RandomPoseMap(&rng);
+    const Eigen::Vector3d motion(2.0, -0.3, 0.2 * trial);
+    const OdometryCost cost(map0, map1, motion, sqrt_information);
+    auto autodiff = testing::MakeAutoDiff(
+        new OdometryAutoDiff{map0, map1, motion, sqrt_information}, cost);
+    testing::ExpectSameCost(
+        cost, *autodiff,
+        testing::RandomParameters(cost.parameter_block_sizes(), &rng));
   }
 }
 
