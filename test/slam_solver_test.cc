@@ -26,7 +26,7 @@ SlamOptions PaperSolverOptions() {
   t.num_heading_features = 24;
   t.segment_length = 50.0;
   t.segment_overlap = 15.0;
-  options.solver.linear_solver = "SPARSE_NORMAL_CHOLESKY";
+  options.solver.linear_solver = "DENSE_SCHUR";
   options.solver.num_threads = 1;
   return options;
 }

@@ -8,6 +8,7 @@
 #include <set>
 #include <string_view>
 
+#include "rff_ceres/convert/raw_records.h"
 #include "rff_ceres/io/text_parser.h"
 
 namespace rff {
@@ -15,47 +16,6 @@ namespace {
 
 // Subjects 1..5 are the robots of the dataset; 6..20 are landmarks.
 constexpr LandmarkId kLastRobotSubject = 5;
-
-// Reads every record of `path`; each must have exactly `num_fields` fields.
-// `parse_row(reader, fields, error)` handles one record.
-template <typename RowParser>
-bool ReadRecords(const std::string& path, std::size_t num_fields,
-                 RowParser parse_row, std::string* error) {
-  std::ifstream stream;
-  if (!OpenForReading(path, &stream, error)) return false;
-  LineReader reader(&stream, path);
-  std::vector<std::string_view> fields;
-  std::size_t rows = 0;
-  while (reader.Next(&fields)) {
-    if (fields.size() != num_fields) {
-      *error = reader.Error("expected " + std::to_string(num_fields) +
-                            " fields, got " + std::to_string(fields.size()));
-      return false;
-    }
-    if (!parse_row(reader, fields, error)) return false;
-    ++rows;
-  }
-  if (!reader.ok()) {
-    *error = reader.error();
-    return false;
-  }
-  if (rows == 0) {
-    *error = path + ": no data rows";
-    return false;
-  }
-  return true;
-}
-
-bool ParseInteger(const LineReader& reader, std::string_view field, int column,
-                  LandmarkId* value, std::string* error) {
-  if (!ParseNonNegativeInt(field, value)) {
-    *error = reader.Error("field " + std::to_string(column) + " '" +
-                          std::string(field.substr(0, 64)) +
-                          "' is not a non-negative integer");
-    return false;
-  }
-  return true;
-}
 
 // Checks that row times do not decrease (strictly increase if `strict`).
 bool CheckTimeOrder(const LineReader& reader, bool have_previous,
@@ -96,8 +56,8 @@ bool ReadBarcodes(const std::string& path, MrclamRaw* raw, std::string* error) {
       [&](const LineReader& reader, const std::vector<std::string_view>& f,
           std::string* err) {
         LandmarkId subject, barcode;
-        if (!ParseInteger(reader, f[0], 1, &subject, err) ||
-            !ParseInteger(reader, f[1], 2, &barcode, err)) {
+        if (!ParseRawInteger(reader, f[0], 1, &subject, err) ||
+            !ParseRawInteger(reader, f[1], 2, &barcode, err)) {
           return false;
         }
         if (!raw->subject_of_barcode.emplace(barcode, subject).second) {
@@ -117,7 +77,7 @@ bool ReadLandmarks(const std::string& path, MrclamRaw* raw,
           std::string* err) {
         LandmarkId subject;
         double v[4];  // x y sx sy; the standard deviations are not used.
-        if (!ParseInteger(reader, f[0], 1, &subject, err) ||
+        if (!ParseRawInteger(reader, f[0], 1, &subject, err) ||
             !ParseFiniteDoubles(reader, f, 1, 4, v, err)) {
           return false;
         }
@@ -187,7 +147,7 @@ bool ReadMeasurements(const std::string& path, MrclamRaw* raw,
         double t, rb[2];
         LandmarkId barcode;
         if (!ParseFiniteDoubles(reader, f, 0, 1, &t, err) ||
-            !ParseInteger(reader, f[1], 2, &barcode, err) ||
+            !ParseRawInteger(reader, f[1], 2, &barcode, err) ||
             !ParseFiniteDoubles(reader, f, 2, 2, rb, err)) {
           return false;
         }

@@ -6,6 +6,7 @@
 #include <map>
 #include <string_view>
 
+#include "rff_ceres/convert/raw_records.h"
 #include "rff_ceres/io/text_parser.h"
 
 namespace rff {
@@ -18,47 +19,6 @@ constexpr double kTimeMatchTolerance = 1e-6;
 // Threshold-and-refit rounds of the range calibration; the inlier set
 // settles in a few.
 constexpr int kMaxCalibrationRounds = 100;
-
-// Reads every record of `path`; each must have exactly `num_fields` fields.
-// `parse_row(reader, fields, error)` handles one record.
-template <typename RowParser>
-bool ReadRecords(const std::string& path, std::size_t num_fields,
-                 RowParser parse_row, std::string* error) {
-  std::ifstream stream;
-  if (!OpenForReading(path, &stream, error)) return false;
-  LineReader reader(&stream, path);
-  std::vector<std::string_view> fields;
-  std::size_t rows = 0;
-  while (reader.Next(&fields)) {
-    if (fields.size() != num_fields) {
-      *error = reader.Error("expected " + std::to_string(num_fields) +
-                            " fields, got " + std::to_string(fields.size()));
-      return false;
-    }
-    if (!parse_row(reader, fields, error)) return false;
-    ++rows;
-  }
-  if (!reader.ok()) {
-    *error = reader.error();
-    return false;
-  }
-  if (rows == 0) {
-    *error = path + ": no data rows";
-    return false;
-  }
-  return true;
-}
-
-bool ParseId(const LineReader& reader, std::string_view field, int column,
-             LandmarkId* id, std::string* error) {
-  if (!ParseNonNegativeInt(field, id)) {
-    *error = reader.Error("field " + std::to_string(column) + " '" +
-                          std::string(field.substr(0, 64)) +
-                          "' is not a non-negative integer");
-    return false;
-  }
-  return true;
-}
 
 struct RawRange {
   double t = 0.0;
@@ -132,7 +92,7 @@ bool ReadBeacons(const std::string& path, PlazaRaw* raw, std::string* error) {
           std::string* err) {
         LandmarkId id;
         double v[2];
-        if (!ParseId(reader, f[0], 1, &id, err) ||
+        if (!ParseRawInteger(reader, f[0], 1, &id, err) ||
             !ParseFiniteDoubles(reader, f, 1, 2, v, err)) {
           return false;
         }
@@ -153,8 +113,8 @@ bool ReadRanges(const std::string& path, PlazaRaw* raw, std::string* error) {
         double t, range;
         LandmarkId sender, beacon;
         if (!ParseFiniteDoubles(reader, f, 0, 1, &t, err) ||
-            !ParseId(reader, f[1], 2, &sender, err) ||
-            !ParseId(reader, f[2], 3, &beacon, err) ||
+            !ParseRawInteger(reader, f[1], 2, &sender, err) ||
+            !ParseRawInteger(reader, f[2], 3, &beacon, err) ||
             !ParseFiniteDoubles(reader, f, 3, 1, &range, err)) {
           return false;
         }
