@@ -52,6 +52,12 @@ DEFINE_double(segment_length, 0.0,
 DEFINE_double(segment_overlap, 0.0,
               "Windowed weights: blend overlap between segments (seconds).");
 
+DEFINE_int32(outer_rounds, 0,
+             "Smoothing-spline prior rounds (paper III-B.2): refit the mean "
+             "to the estimate and re-solve this many times.");
+DEFINE_double(spline_smoothing, 0.98,
+              "Smoothing parameter p of the spline mean (De Boor).");
+
 // Problem.
 DEFINE_string(loss, "none",
               "Robust loss on observations: none, huber, cauchy.");
@@ -89,6 +95,8 @@ int Fail(const std::string& message) {
 rff::SlamOptions OptionsFromFlags() {
   rff::SlamOptions options;
   options.prior_mean = FLAGS_prior_mean;
+  options.outer_rounds = FLAGS_outer_rounds;
+  options.spline_smoothing = FLAGS_spline_smoothing;
   rff::FeatureTrajectoryOptions& t = options.trajectory;
   t.position_kernel.name = FLAGS_kernel;
   t.position_kernel.lengthscale = FLAGS_lengthscale;
@@ -161,7 +169,7 @@ int main(int argc, char** argv) {
             << "  problem      " << s.num_residual_blocks
             << " residual blocks, " << s.num_parameters << " parameters\n"
             << "  solver       " << options.solver.linear_solver << ", "
-            << s.iterations.size() << " iterations, "
+            << result.total_iterations << " iterations, "
             << ceres::TerminationTypeToString(s.termination_type) << "\n"
             << "  cost         " << s.initial_cost << " -> " << s.final_cost
             << "\n"

@@ -10,6 +10,7 @@
 #include "rff_ceres/io/text_parser.h"
 #include "rff_ceres/landmark_init.h"
 #include "rff_ceres/mean/prior_mean.h"
+#include "rff_ceres/mean/spline_mean.h"
 
 namespace rff {
 namespace {
@@ -137,6 +138,16 @@ bool RunSlam(const Dataset& dataset, const SlamOptions& options,
   *result = SlamResult();
   ceres::Solver::Options ceres_options;
   if (!ToCeresOptions(options.solver, &ceres_options, error)) return false;
+  if (options.outer_rounds < 0) {
+    *error = "outer_rounds must be >= 0, got " +
+             std::to_string(options.outer_rounds);
+    return false;
+  }
+  if (!(options.spline_smoothing >= 0.0 && options.spline_smoothing <= 1.0)) {
+    *error = "spline_smoothing must be in [0, 1], got " +
+             FormatNumber(options.spline_smoothing);
+    return false;
+  }
 
   std::shared_ptr<const MeanFunction> mean =
       BuildPriorMean(options.prior_mean, dataset, error);
@@ -153,36 +164,58 @@ bool RunSlam(const Dataset& dataset, const SlamOptions& options,
           error)) {
     return false;
   }
-  SlamProblem problem(model.get(), options.problem);
-  if (!problem.Build(dataset, landmarks, error)) return false;
-  ceres_options.linear_solver_ordering = problem.Ordering();
   ProgressLogger progress;
   if (options.solver.log_progress) ceres_options.callbacks.push_back(&progress);
-  ceres::Solve(ceres_options, problem.problem(), &result->summary);
-  VLOG(1) << result->summary.FullReport();
-
-  const ceres::Solver::Summary& summary = result->summary;
-  if (summary.termination_type == ceres::FAILURE ||
-      summary.termination_type == ceres::USER_FAILURE ||
-      !std::isfinite(summary.final_cost)) {
-    *error = "the solve failed: " + summary.message;
-    return false;
-  }
-  result->converged = summary.termination_type == ceres::CONVERGENCE;
-
-  for (const double t : OutputTimes(dataset)) {
-    const Eigen::Vector3d pose = model->Pose(t);
-    if (!pose.allFinite()) {
-      *error = "the solve diverged: non-finite pose at t = " + FormatNumber(t);
+  // Paper III-B.2: after each solve the prior mean becomes a smoothing spline
+  // of the estimate and the weights restart from zero.
+  for (int round = 0;; ++round) {
+    SlamProblem problem(model.get(), options.problem);
+    if (!problem.Build(dataset, landmarks, error)) return false;
+    ceres_options.linear_solver_ordering = problem.Ordering();
+    ceres::Solve(ceres_options, problem.problem(), &result->summary);
+    VLOG(1) << result->summary.FullReport();
+    const ceres::Solver::Summary& summary = result->summary;
+    if (summary.termination_type == ceres::FAILURE ||
+        summary.termination_type == ceres::USER_FAILURE ||
+        !std::isfinite(summary.final_cost)) {
+      *error = "the solve failed: " + summary.message;
       return false;
     }
-    result->trajectory.push_back({t, pose.x(), pose.y(), WrapAngle(pose.z())});
-  }
-  for (const auto& [id, position] : problem.landmarks()) {
-    if (!position.allFinite()) {
-      *error = "the solve diverged: non-finite landmark " + std::to_string(id);
-      return false;
+    result->converged = summary.termination_type == ceres::CONVERGENCE;
+    result->total_iterations += static_cast<int>(summary.iterations.size());
+    landmarks = problem.landmarks();
+
+    result->trajectory.clear();
+    for (const double t : OutputTimes(dataset)) {
+      const Eigen::Vector3d pose = model->Pose(t);
+      if (!pose.allFinite()) {
+        *error =
+            "the solve diverged: non-finite pose at t = " + FormatNumber(t);
+        return false;
+      }
+      result->trajectory.push_back(
+          {t, pose.x(), pose.y(), WrapAngle(pose.z())});
     }
+    for (const auto& [id, position] : landmarks) {
+      if (!position.allFinite()) {
+        *error =
+            "the solve diverged: non-finite landmark " + std::to_string(id);
+        return false;
+      }
+    }
+    if (round >= options.outer_rounds) break;
+    mean =
+        RefitSplineMean(result->trajectory,
+                        DataFitWeights(dataset, result->trajectory, landmarks),
+                        options.spline_smoothing, error);
+    if (!mean) return false;
+    model->set_mean(mean);
+    for (int b = 0; b < model->num_blocks(); ++b) {
+      Eigen::Map<Eigen::VectorXd>(model->mutable_block(b), model->block_size(b))
+          .setZero();
+    }
+  }
+  for (const auto& [id, position] : landmarks) {
     Landmark l;
     l.id = id;
     l.x = position.x();
@@ -230,7 +263,8 @@ bool WriteSummaryJson(const SlamOptions& options, const SlamResult& result,
       << "  \"termination\": "
       << quote(ceres::TerminationTypeToString(s.termination_type)) << ",\n"
       << "  \"converged\": " << (result.converged ? "true" : "false") << ",\n"
-      << "  \"iterations\": " << s.iterations.size() << ",\n"
+      << "  \"iterations\": " << result.total_iterations << ",\n"
+      << "  \"outer_rounds\": " << options.outer_rounds << ",\n"
       << "  \"initial_cost\": " << FormatNumber(s.initial_cost) << ",\n"
       << "  \"final_cost\": " << FormatNumber(s.final_cost) << ",\n"
       << "  \"num_residual_blocks\": " << s.num_residual_blocks << ",\n"

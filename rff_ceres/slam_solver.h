@@ -37,6 +37,10 @@ struct SlamOptions {
   FeatureTrajectoryOptions trajectory;
   ProblemOptions problem;
   SolverOptions solver;
+  // Outer rounds of the paper's smoothing-spline prior (III-B.2): after each
+  // solve, refit the mean to the estimate and solve again. 0: one solve.
+  int outer_rounds = 0;
+  double spline_smoothing = 0.98;  // De Boor's p.
 };
 
 struct SlamResult {
@@ -44,9 +48,10 @@ struct SlamResult {
   // reads the GT times, never the GT poses), headings wrapped.
   std::vector<TimedPose> trajectory;
   std::vector<Landmark> landmarks;  // Sorted by id.
-  ceres::Solver::Summary summary;
-  double solve_seconds = 0.0;  // Wall time of the whole RunSlam.
-  bool converged = false;      // Ceres reported CONVERGENCE.
+  ceres::Solver::Summary summary;   // Of the last solve.
+  int total_iterations = 0;         // Over all outer rounds.
+  double solve_seconds = 0.0;       // Wall time of the whole RunSlam.
+  bool converged = false;           // Ceres reported CONVERGENCE.
 };
 
 // Runs the solve. Returns false with a message on bad options or input, and

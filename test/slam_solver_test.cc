@@ -61,6 +61,21 @@ TEST(SlamSolverTest, RangeBearingWithOdometryBeatsDeadReckoningByFar) {
       << errors[0] << " " << errors[1] << " " << errors[2];
 }
 
+TEST(SlamSolverTest, SplineRoundsKeepTheAccuracy) {
+  SimulationOptions sim = PaperOptions(12);
+  sim.num_landmarks = 20;
+  Dataset dataset;
+  std::string error;
+  ASSERT_TRUE(Simulate(sim, &dataset, &error)) << error;
+  SlamOptions options = PaperSolverOptions();
+  options.outer_rounds = 2;
+  SlamResult result;
+  ASSERT_TRUE(RunSlam(dataset, options, &result, &error)) << error;
+  EXPECT_GT(result.total_iterations,
+            static_cast<int>(result.summary.iterations.size()));
+  EXPECT_LT(ApeTranslation(dataset, result), 0.6);
+}
+
 TEST(SlamSolverTest, NoiseFreeDataIsRecovered) {
   SimulationOptions sim = PaperOptions(21);
   sim.num_steps = 120;
@@ -159,6 +174,12 @@ INSTANTIATE_TEST_SUITE_P(
         BadOption{"OverlapLongerThanSegment",
                   [](SlamOptions* o) { o->trajectory.segment_overlap = 60.0; },
                   "overlap < length"},
+        BadOption{"NegativeOuterRounds",
+                  [](SlamOptions* o) { o->outer_rounds = -1; },
+                  "outer_rounds must be >= 0"},
+        BadOption{"SplineSmoothingAboveOne",
+                  [](SlamOptions* o) { o->spline_smoothing = 1.5; },
+                  "spline_smoothing must be in [0, 1]"},
         BadOption{"UnknownPriorMean",
                   [](SlamOptions* o) { o->prior_mean = "psychic"; },
                   "unknown prior mean 'psychic'"}),

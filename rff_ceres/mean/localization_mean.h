@@ -44,24 +44,36 @@ struct PoseFix {
 // `seeds`, keeping the lowest cost. The landmark sigma is added to the
 // measurement noise (sigma_r^2 + s^2; sigma_b^2 + (s / r)^2). With
 // `fixed_heading` (range-bearing from one landmark) the heading is held at
-// that value. Returns false when the measurements do not determine the pose
-// (fewer equations than unknowns, or a degenerate geometry) or when no
+// that value, and its uncertainty `fixed_heading_sigma` is carried into the
+// position covariance. Returns false when the measurements do not determine the
+// pose (fewer equations than unknowns, or a degenerate geometry) or when no
 // start converges.
 bool LocalizePose(const std::vector<Observation>& observations,
                   const std::map<LandmarkId, KnownLandmark>& landmarks,
                   const std::vector<Eigen::Vector3d>& seeds,
-                  const double* fixed_heading, PoseFix* fix);
+                  const double* fixed_heading, double fixed_heading_sigma,
+                  PoseFix* fix);
 
 struct LocalizationOptions {
   // Acceleration noise density q (m^2/s^3) of the position smoother: the
   // spline minimises sum (fix - f)^2 / var + (1 / q) int f''^2. Larger
   // follows the fixes more closely.
-  double position_smoothing = 0.05;
+  double position_smoothing = 0.2;
   // The same for the heading (rad^2/s^3), when the fixes carry it.
   double heading_smoothing = 0.005;
   // With odometry: the smoother of the correction (fix - dead reckoning),
   // which drifts slowly.
   double correction_smoothing = 1e-4;
+  // Uncertainty of the predicted heading that a range-bearing fix from one
+  // landmark holds (rad).
+  double held_heading_sigma = 0.1;
+  // The running prediction that seeds each time is a random walk filtered
+  // through the fixes: of the pose without odometry, of the correction to
+  // dead reckoning with it (spectral densities per second: m^2, rad^2).
+  double walk_position = 4.0;
+  double walk_heading = 0.1;
+  double walk_correction_position = 0.01;
+  double walk_correction_heading = 1e-3;
   // A fix whose chi^2 per degree of freedom exceeds this is discarded.
   double max_chi2_per_dof = 9.0;
   // Robust smoothing: iterations of reweighting (Cauchy weights at this
@@ -75,9 +87,9 @@ struct LocalizationOptions {
 
 // What the localiser did, for reports and tests.
 struct LocalizationReport {
-  int times = 0;         // Distinct observation times.
-  int localized = 0;     // Fixes kept.
-  int rejected = 0;      // Fixes discarded by the residual check.
+  int times = 0;      // Distinct observation times.
+  int localized = 0;  // Fixes kept.
+  int rejected = 0;   // Fixes discarded by the residual check.
   bool heading_from_velocity = false;
   bool fused_odometry = false;
   std::vector<PoseFix> fixes;  // The kept fixes, in time order.

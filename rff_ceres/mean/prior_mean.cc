@@ -3,14 +3,19 @@
 #include <algorithm>
 
 #include "rff_ceres/dead_reckoning.h"
+#include "rff_ceres/mean/localization_mean.h"
+#include "rff_ceres/mean/spline_mean.h"
 
 namespace rff {
 
 std::vector<std::string> PriorMeanNames() {
-  return {"auto", "odometry", "constant"};
+  return {"auto", "odometry", "localization", "spline", "constant"};
 }
 
 namespace {
+
+// The paper's smoothing parameter of the spline prior (III-B.2).
+constexpr double kPaperSplineSmoothing = 0.98;
 
 const PosePrior& EarliestPrior(const Dataset& dataset) {
   return *std::min_element(dataset.pose_priors.begin(),
@@ -20,14 +25,37 @@ const PosePrior& EarliestPrior(const Dataset& dataset) {
                            });
 }
 
+std::string NameList() {
+  std::string list;
+  const std::vector<std::string> names = PriorMeanNames();
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    list += (i == 0 ? "" : i + 1 == names.size() ? " or " : ", ") + names[i];
+  }
+  return list;
+}
+
 }  // namespace
 
 std::shared_ptr<const MeanFunction> BuildPriorMean(const std::string& name,
                                                    const Dataset& dataset,
                                                    std::string* error) {
+  if (name != "odometry" && name != "localization" && name != "spline" &&
+      name != "constant" && name != "auto") {
+    *error = "unknown prior mean '" + name + "' (expected " + NameList() + ")";
+    return nullptr;
+  }
+  if (dataset.pose_priors.empty()) {
+    *error = "prior mean '" + name + "': the dataset has no PRIOR_POSE record";
+    return nullptr;
+  }
   if (name == "auto") {
-    return BuildPriorMean(dataset.odometry.empty() ? "constant" : "odometry",
-                          dataset, error);
+    if (!dataset.odometry.empty()) {
+      return BuildPriorMean("odometry", dataset, error);
+    }
+    std::string ignored;
+    std::shared_ptr<const MeanFunction> mean =
+        BuildPriorMean("localization", dataset, &ignored);
+    return mean ? mean : BuildPriorMean("constant", dataset, error);
   }
   if (name == "constant") {
     return std::make_shared<PiecewiseLinearMean>(
@@ -43,9 +71,29 @@ std::shared_ptr<const MeanFunction> BuildPriorMean(const std::string& name,
     }
     return std::make_shared<PiecewiseLinearMean>(result.poses);
   }
-  *error =
-      "unknown prior mean '" + name + "' (expected auto, odometry or constant)";
-  return nullptr;
+  if (name == "localization") {
+    LocalizationReport report;
+    return BuildLocalizationMean(dataset, LocalizationOptions(), &report,
+                                 error);
+  }
+  // "spline": through the auto mean at every observation and prior time.
+  std::shared_ptr<const MeanFunction> base =
+      BuildPriorMean("auto", dataset, error);
+  if (!base) return nullptr;
+  std::vector<double> times;
+  for (const Observation& o : dataset.observations) times.push_back(o.t);
+  for (const PosePrior& p : dataset.pose_priors) times.push_back(p.pose.t);
+  std::sort(times.begin(), times.end());
+  times.erase(std::unique(times.begin(), times.end()), times.end());
+  std::vector<TimedPose> poses;
+  for (const double t : times) {
+    const Eigen::Vector3d p = base->Evaluate(t);
+    poses.push_back({t, p.x(), p.y(), p.z()});
+  }
+  std::shared_ptr<const MeanFunction> mean =
+      RefitSplineMean(poses, {}, kPaperSplineSmoothing, error);
+  if (!mean) *error = "prior mean 'spline': " + *error;
+  return mean;
 }
 
 }  // namespace rff

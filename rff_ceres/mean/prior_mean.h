@@ -1,6 +1,6 @@
 // Builds the prior mean mu(t) of the trajectory from a dataset (paper
-// section III-B): the odometry motion model, a constant pose, or "auto"
-// (odometry when the dataset has ODOM records).
+// section III-B): the odometry motion model, localisation against the
+// landmark priors, a smoothing spline, a constant pose, or "auto".
 #ifndef RFF_CERES_MEAN_PRIOR_MEAN_H_
 #define RFF_CERES_MEAN_PRIOR_MEAN_H_
 
@@ -17,8 +17,14 @@ namespace rff {
 std::vector<std::string> PriorMeanNames();
 
 // "odometry": dead reckoning from the earliest PRIOR_POSE (paper III-B.1).
+// "localization": per-time localisation against the PRIOR_LANDMARK means,
+//   smoothed robustly; fused with dead reckoning when the dataset has ODOM
+//   (see localization_mean.h and docs/prior_means.md).
+// "spline": a smoothing spline (p = 0.98) through the "auto" mean at the
+//   observation times, the first round of the paper's III-B.2.
 // "constant": the earliest PRIOR_POSE at every time.
-// "auto": odometry if the dataset has ODOM records, else constant.
+// "auto": odometry if the dataset has ODOM records, else localization if
+//   some time can be localised, else constant.
 std::shared_ptr<const MeanFunction> BuildPriorMean(const std::string& name,
                                                    const Dataset& dataset,
                                                    std::string* error);

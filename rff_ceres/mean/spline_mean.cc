@@ -15,10 +15,11 @@ bool CubicSmoothingSpline::Fit(const std::vector<double>& t,
                                std::string* error) {
   const std::size_t n = t.size();
   if (n == 0 || y.size() != n || w.size() != n) {
-    *error = "smoothing spline: need equally many times, values and weights "
-             "(at least one), got " +
-             std::to_string(t.size()) + ", " + std::to_string(y.size()) +
-             ", " + std::to_string(w.size());
+    *error =
+        "smoothing spline: need equally many times, values and weights "
+        "(at least one), got " +
+        std::to_string(t.size()) + ", " + std::to_string(y.size()) + ", " +
+        std::to_string(w.size());
     return false;
   }
   if (!(p >= 0.0 && p <= 1.0)) {
@@ -134,8 +135,10 @@ std::size_t CubicSmoothingSpline::Interval(double t) const {
 
 double CubicSmoothingSpline::Evaluate(double t) const {
   if (t_.size() == 1) return g_[0];
-  if (t <= t_.front()) return g_.front() + Derivative(t_.front()) * (t - t_.front());
-  if (t >= t_.back()) return g_.back() + Derivative(t_.back()) * (t - t_.back());
+  if (t <= t_.front())
+    return g_.front() + Derivative(t_.front()) * (t - t_.front());
+  if (t >= t_.back())
+    return g_.back() + Derivative(t_.back()) * (t - t_.back());
   const std::size_t i = Interval(t);
   const double h = t_[i + 1] - t_[i];
   const double b = (t - t_[i]) / h, a = 1.0 - b;
@@ -216,9 +219,9 @@ std::shared_ptr<SplineMean> SplineMean::Fit(const std::vector<TimedPose>& poses,
     t.push_back(p.t);
     x.push_back(p.x);
     y.push_back(p.y);
-    theta.push_back(theta.empty() ? p.theta
-                                  : theta.back() +
-                                        WrapAngle(p.theta - theta.back()));
+    theta.push_back(theta.empty()
+                        ? p.theta
+                        : theta.back() + WrapAngle(p.theta - theta.back()));
   }
   std::vector<double> w = weights;
   if (w.empty()) w.assign(poses.size(), 1.0);
@@ -228,7 +231,8 @@ std::shared_ptr<SplineMean> SplineMean::Fit(const std::vector<TimedPose>& poses,
     for (double& v : w) v *= w.size() / sum;
   }
   CubicSmoothingSpline sx, sy, st;
-  if (!sx.Fit(t, x, w, smoothing, error) || !sy.Fit(t, y, w, smoothing, error) ||
+  if (!sx.Fit(t, x, w, smoothing, error) ||
+      !sy.Fit(t, y, w, smoothing, error) ||
       !st.Fit(t, theta, w, smoothing, error)) {
     *error = "spline mean: " + *error;
     return nullptr;
@@ -250,9 +254,9 @@ std::vector<double> DataFitWeights(
   std::vector<double> sum(estimate.size(), 0.0);
   std::vector<int> count(estimate.size(), 0);
   for (const Observation& o : dataset.observations) {
-    const auto pose = std::lower_bound(
-        estimate.begin(), estimate.end(), o.t,
-        [](const TimedPose& p, double t) { return p.t < t; });
+    const auto pose =
+        std::lower_bound(estimate.begin(), estimate.end(), o.t,
+                         [](const TimedPose& p, double t) { return p.t < t; });
     const auto landmark = landmarks.find(o.id);
     if (pose == estimate.end() || pose->t != o.t ||
         landmark == landmarks.end()) {

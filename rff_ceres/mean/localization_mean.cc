@@ -1,0 +1,522 @@
+#include "rff_ceres/mean/localization_mean.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "Eigen/Dense"
+#include "rff_ceres/dead_reckoning.h"
+#include "rff_ceres/io/text_parser.h"
+#include "rff_ceres/mean/spline_mean.h"
+
+namespace rff {
+namespace {
+
+constexpr double kUnmeasuredHeadingVariance = 1e6;
+
+// One whitened residual row over the unknowns (x, y, theta).
+struct Row {
+  double residual = 0.0;
+  Eigen::RowVector3d jacobian = Eigen::RowVector3d::Zero();
+};
+
+// Whitened residuals of `observations` at pose `p`.
+std::vector<Row> Residuals(const std::vector<Observation>& observations,
+                           const std::map<LandmarkId, KnownLandmark>& landmarks,
+                           const Eigen::Vector3d& p) {
+  std::vector<Row> rows;
+  for (const Observation& o : observations) {
+    const KnownLandmark& l = landmarks.at(o.id);
+    const Eigen::Vector2d d = l.position - p.head<2>();
+    const double distance = std::max(d.norm(), 1e-6);
+    if (o.HasRange()) {
+      const double sigma =
+          std::sqrt(o.sigma_range * o.sigma_range + l.sigma * l.sigma);
+      Row row;
+      row.residual = (distance - o.range) / sigma;
+      row.jacobian << -d.x() / distance / sigma, -d.y() / distance / sigma, 0.0;
+      rows.push_back(row);
+    }
+    if (o.HasBearing()) {
+      const double spread = l.sigma / distance;
+      const double sigma =
+          std::sqrt(o.sigma_bearing * o.sigma_bearing + spread * spread);
+      const double d2 = distance * distance;
+      Row row;
+      row.residual =
+          WrapAngle(std::atan2(d.y(), d.x()) - p.z() - o.bearing) / sigma;
+      row.jacobian << d.y() / d2 / sigma, -d.x() / d2 / sigma, -1.0 / sigma;
+      rows.push_back(row);
+    }
+  }
+  return rows;
+}
+
+double Cost(const std::vector<Row>& rows) {
+  double cost = 0.0;
+  for (const Row& r : rows) cost += r.residual * r.residual;
+  return cost;
+}
+
+// Levenberg-Marquardt from `start` over the free unknowns (`free_heading`
+// false holds theta). Returns the final cost and leaves the pose in `pose`.
+double Refine(const std::vector<Observation>& observations,
+              const std::map<LandmarkId, KnownLandmark>& landmarks,
+              bool free_heading, Eigen::Vector3d* pose) {
+  const int n = free_heading ? 3 : 2;
+  std::vector<Row> rows = Residuals(observations, landmarks, *pose);
+  double cost = Cost(rows);
+  double lambda = 1e-3;
+  for (int iteration = 0; iteration < 50; ++iteration) {
+    Eigen::Matrix3d h = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d g = Eigen::Vector3d::Zero();
+    for (const Row& r : rows) {
+      h += r.jacobian.transpose() * r.jacobian;
+      g += r.jacobian.transpose() * r.residual;
+    }
+    const Eigen::MatrixXd hn = h.topLeftCorner(n, n);
+    Eigen::MatrixXd damped = hn;
+    damped.diagonal() += lambda * (hn.diagonal().array() + 1e-9).matrix();
+    const Eigen::VectorXd step = -damped.ldlt().solve(g.head(n));
+    Eigen::Vector3d candidate = *pose;
+    candidate.head(n) += step;
+    if (!candidate.allFinite()) break;
+    const std::vector<Row> next = Residuals(observations, landmarks, candidate);
+    const double next_cost = Cost(next);
+    if (next_cost < cost) {
+      const bool small = cost - next_cost < 1e-12 * (1.0 + cost) ||
+                         step.norm() < 1e-12 * (1.0 + pose->head(2).norm());
+      *pose = candidate;
+      rows = next;
+      cost = next_cost;
+      lambda = std::max(lambda / 10.0, 1e-12);
+      if (small) break;
+    } else {
+      lambda *= 10.0;
+      if (lambda > 1e12) break;
+    }
+  }
+  return cost;
+}
+
+}  // namespace
+
+bool LocalizePose(const std::vector<Observation>& observations,
+                  const std::map<LandmarkId, KnownLandmark>& landmarks,
+                  const std::vector<Eigen::Vector3d>& seeds,
+                  const double* fixed_heading, double fixed_heading_sigma,
+                  PoseFix* fix) {
+  std::vector<Observation> usable;
+  int equations = 0, bearings = 0;
+  for (const Observation& o : observations) {
+    if (landmarks.count(o.id) == 0) continue;
+    usable.push_back(o);
+    equations += o.HasRange() + o.HasBearing();
+    bearings += o.HasBearing();
+  }
+  if (usable.empty() || seeds.empty()) return false;
+  const bool free_heading = bearings > 0 && fixed_heading == nullptr;
+  const int unknowns = free_heading ? 3 : 2;
+  if (equations < unknowns) return false;
+
+  // Every start converges to some minimum; near-degenerate geometries (two
+  // close landmarks) have several that fit about equally well, so among the
+  // minima within kAmbiguousChi2 of the best take the one nearest the first
+  // seed (the prediction).
+  constexpr double kAmbiguousChi2 = 4.0;
+  std::vector<std::pair<double, Eigen::Vector3d>> minima;
+  double lowest = std::numeric_limits<double>::infinity();
+  for (Eigen::Vector3d pose : seeds) {
+    if (fixed_heading != nullptr) pose.z() = *fixed_heading;
+    const double cost = Refine(usable, landmarks, free_heading, &pose);
+    if (!std::isfinite(cost) || !pose.allFinite()) continue;
+    minima.emplace_back(cost, pose);
+    lowest = std::min(lowest, cost);
+  }
+  if (minima.empty()) return false;
+  double best_cost = 0.0, nearest = std::numeric_limits<double>::infinity();
+  Eigen::Vector3d best = seeds.front();
+  for (const auto& [cost, pose] : minima) {
+    if (cost > lowest + kAmbiguousChi2) continue;
+    // Metres, and a radian of heading counted as a metre.
+    const double distance =
+        (pose.head<2>() - seeds.front().head<2>()).norm() +
+        (free_heading ? std::abs(WrapAngle(pose.z() - seeds.front().z())) : 0);
+    if (distance < nearest) {
+      nearest = distance;
+      best_cost = cost;
+      best = pose;
+    }
+  }
+
+  // Information of the free unknowns; a degenerate geometry (collinear
+  // landmarks, parallel bearings) leaves it singular.
+  Eigen::Matrix3d h = Eigen::Matrix3d::Zero();
+  for (const Row& r : Residuals(usable, landmarks, best)) {
+    h += r.jacobian.transpose() * r.jacobian;
+  }
+  const Eigen::MatrixXd hn = h.topLeftCorner(unknowns, unknowns);
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(hn);
+  const Eigen::VectorXd values = eigen.eigenvalues();
+  if (!(values(0) > 1e-9 * values(unknowns - 1)) || !(values(0) > 0.0)) {
+    return false;
+  }
+  fix->covariance = Eigen::Matrix3d::Zero();
+  if (fixed_heading != nullptr && bearings > 0) {
+    // Marginalise the held heading with its prior: the position inherits
+    // range * heading error across the line of sight.
+    Eigen::Matrix3d with_prior = h;
+    with_prior(2, 2) += 1.0 / (fixed_heading_sigma * fixed_heading_sigma);
+    fix->covariance = with_prior.inverse();
+  } else {
+    fix->covariance.topLeftCorner(unknowns, unknowns) = hn.inverse();
+  }
+  if (!free_heading) fix->covariance(2, 2) = kUnmeasuredHeadingVariance;
+  fix->pose.x = best.x();
+  fix->pose.y = best.y();
+  fix->pose.theta = WrapAngle(best.z());
+  fix->has_heading = free_heading;
+  fix->chi2 = best_cost;
+  fix->dof = equations - unknowns;
+  return true;
+}
+
+namespace {
+
+// The csaps p for data weighted by inverse variances and a roughness penalty
+// of 1/q: sum w (y - f)^2 + (1/q) int f''^2 is p/(1-p) = q.
+double SmoothingFromNoiseDensity(double q) { return q / (1.0 + q); }
+
+// Robust smoothing spline: Cauchy reweighting of the points whose residual
+// is many standard deviations. `variance` per point; the same robust weight
+// is applied to every coordinate of a point (x and y together).
+bool RobustFit(const std::vector<double>& t,
+               const std::vector<std::vector<double>>& values,
+               const std::vector<std::vector<double>>& variances, double q,
+               const LocalizationOptions& options,
+               std::vector<CubicSmoothingSpline>* splines, std::string* error) {
+  const std::size_t n = t.size();
+  const std::size_t dims = values.size();
+  std::vector<double> robust(n, 1.0);
+  splines->assign(dims, CubicSmoothingSpline());
+  const double p = SmoothingFromNoiseDensity(q);
+  for (int iteration = 0; iteration <= options.robust_iterations; ++iteration) {
+    for (std::size_t k = 0; k < dims; ++k) {
+      std::vector<double> w(n);
+      for (std::size_t i = 0; i < n; ++i) {
+        w[i] = std::max(robust[i] / variances[k][i], 1e-12);
+      }
+      if (!(*splines)[k].Fit(t, values[k], w, p, error)) return false;
+    }
+    for (std::size_t i = 0; i < n; ++i) {
+      double u2 = 0.0;
+      for (std::size_t k = 0; k < dims; ++k) {
+        const double r = values[k][i] - (*splines)[k].Evaluate(t[i]);
+        u2 += r * r / variances[k][i];
+      }
+      u2 /= dims * options.robust_scale * options.robust_scale;
+      robust[i] = 1.0 / (1.0 + u2);
+    }
+  }
+  return true;
+}
+
+// Points of one smoothed coordinate set, merged by time (information
+// weighted), so that the spline's times increase strictly.
+struct Series {
+  std::vector<double> t;
+  std::vector<std::vector<double>> values, variances;
+
+  explicit Series(std::size_t dims) : values(dims), variances(dims) {}
+  void Add(double time, const std::vector<double>& v,
+           const std::vector<double>& var) {
+    if (!t.empty() && t.back() == time) {
+      for (std::size_t k = 0; k < v.size(); ++k) {
+        const double a = 1.0 / variances[k].back(), b = 1.0 / var[k];
+        values[k].back() = (a * values[k].back() + b * v[k]) / (a + b);
+        variances[k].back() = 1.0 / (a + b);
+      }
+      return;
+    }
+    t.push_back(time);
+    for (std::size_t k = 0; k < v.size(); ++k) {
+      values[k].push_back(v[k]);
+      variances[k].push_back(var[k]);
+    }
+  }
+};
+
+// Time-sorted PRIOR_POSE and fix points in one list.
+struct Point {
+  double t;
+  Eigen::Vector3d pose;
+  Eigen::Vector3d variance;  // x, y, theta
+  bool has_heading;
+};
+
+std::vector<Point> Points(const Dataset& dataset,
+                          const std::vector<PoseFix>& fixes) {
+  std::vector<Point> points;
+  for (const PosePrior& p : dataset.pose_priors) {
+    const double vxy = p.sigma_xy * p.sigma_xy;
+    points.push_back({p.pose.t,
+                      {p.pose.x, p.pose.y, p.pose.theta},
+                      {vxy, vxy, p.sigma_theta * p.sigma_theta},
+                      true});
+  }
+  for (const PoseFix& f : fixes) {
+    points.push_back(
+        {f.pose.t,
+         {f.pose.x, f.pose.y, f.pose.theta},
+         {f.covariance(0, 0), f.covariance(1, 1), f.covariance(2, 2)},
+         f.has_heading});
+  }
+  std::stable_sort(points.begin(), points.end(),
+                   [](const Point& a, const Point& b) { return a.t < b.t; });
+  return points;
+}
+
+// Seeds for one time: the prediction, and for measurements with bearings
+// the prediction turned by multiples of 45 degrees, each also moved to where
+// the range-bearing measurements put it under that heading.
+std::vector<Eigen::Vector3d> Seeds(
+    const std::vector<Observation>& observations,
+    const std::map<LandmarkId, KnownLandmark>& landmarks,
+    const Eigen::Vector3d& prediction) {
+  std::vector<Eigen::Vector3d> seeds = {prediction};
+  bool bearings = false;
+  for (const Observation& o : observations) bearings |= o.HasBearing();
+  for (int k = 0; k < 8; ++k) {
+    Eigen::Vector3d seed = prediction;
+    seed.z() += k * M_PI / 4.0;
+    if (bearings && k > 0) seeds.push_back(seed);
+    Eigen::Vector2d sum = Eigen::Vector2d::Zero();
+    int count = 0;
+    for (const Observation& o : observations) {
+      if (o.type != ObservationType::kRangeBearing || !landmarks.count(o.id)) {
+        continue;
+      }
+      const double angle = seed.z() + o.bearing;
+      sum += landmarks.at(o.id).position -
+             o.range * Eigen::Vector2d(std::cos(angle), std::sin(angle));
+      ++count;
+    }
+    if (count > 0) {
+      seed.head<2>() = sum / count;
+      seeds.push_back(seed);
+    }
+  }
+  return seeds;
+}
+
+}  // namespace
+
+std::shared_ptr<const MeanFunction> BuildLocalizationMean(
+    const Dataset& dataset, const LocalizationOptions& options,
+    LocalizationReport* report, std::string* error) {
+  *report = LocalizationReport();
+  const std::string prefix = "prior mean 'localization': ";
+  std::map<LandmarkId, KnownLandmark> landmarks;
+  for (const LandmarkPrior& l : dataset.landmark_priors) {
+    landmarks[l.id] = {Eigen::Vector2d(l.x, l.y), l.sigma};
+  }
+  if (landmarks.empty()) {
+    *error = prefix +
+             "the dataset has no PRIOR_LANDMARK records to localise against";
+    return nullptr;
+  }
+  if (dataset.pose_priors.empty()) {
+    *error = prefix + "the dataset has no PRIOR_POSE record";
+    return nullptr;
+  }
+  const PosePrior& first =
+      *std::min_element(dataset.pose_priors.begin(), dataset.pose_priors.end(),
+                        [](const PosePrior& a, const PosePrior& b) {
+                          return a.pose.t < b.pose.t;
+                        });
+
+  // Dead reckoning, when fused: the fixes then only correct its drift.
+  std::unique_ptr<PiecewiseLinearMean> dead_reckoning;
+  DeadReckoningResult dr;
+  if (options.use_odometry && !dataset.odometry.empty()) {
+    DeadReckoningOptions dr_options;
+    dr_options.hold_through_gaps = true;
+    if (!DeadReckon(dataset, dr_options, &dr, error)) {
+      *error = prefix + *error;
+      return nullptr;
+    }
+    dead_reckoning = std::make_unique<PiecewiseLinearMean>(dr.poses);
+    report->fused_odometry = true;
+  }
+
+  // Localise each distinct observation time, seeded from a running
+  // prediction: base(t) + state, base being dead reckoning (the state is then
+  // its correction) or zero (the state is the pose). The state is a random
+  // walk filtered through the fixes, one scalar Kalman filter per component,
+  // so that one poor fix does not derail the seeds and held headings after
+  // it.
+  Eigen::Vector3d state = Eigen::Vector3d::Zero();
+  Eigen::Vector3d state_variance;
+  Eigen::Vector3d walk;
+  if (dead_reckoning) {
+    walk << options.walk_correction_position, options.walk_correction_position,
+        options.walk_correction_heading;
+  } else {
+    state << first.pose.x, first.pose.y, first.pose.theta;
+    walk << options.walk_position, options.walk_position, options.walk_heading;
+  }
+  state_variance << first.sigma_xy * first.sigma_xy,
+      first.sigma_xy * first.sigma_xy, first.sigma_theta * first.sigma_theta;
+  double state_time = first.pose.t;
+  auto base = [&](double t) {
+    return dead_reckoning ? dead_reckoning->Evaluate(t)
+                          : Eigen::Vector3d::Zero().eval();
+  };
+  const std::vector<Observation>& all = dataset.observations;
+  for (std::size_t begin = 0; begin < all.size();) {
+    std::size_t end = begin;
+    while (end < all.size() && all[end].t == all[begin].t) ++end;
+    const std::vector<Observation> at(all.begin() + begin, all.begin() + end);
+    const double t = all[begin].t;
+    begin = end;
+    ++report->times;
+
+    const Eigen::Vector3d prediction = base(t) + state;
+    int equations = 0, bearings = 0;
+    for (const Observation& o : at) {
+      if (!landmarks.count(o.id)) continue;
+      equations += o.HasRange() + o.HasBearing();
+      bearings += o.HasBearing();
+    }
+    // Too few equations for (x, y, theta): hold the predicted heading.
+    const bool hold_heading = bearings > 0 && equations < 3;
+    const double heading = prediction.z();
+    PoseFix fix;
+    if (!LocalizePose(at, landmarks, Seeds(at, landmarks, prediction),
+                      hold_heading ? &heading : nullptr,
+                      options.held_heading_sigma, &fix)) {
+      continue;
+    }
+    fix.pose.t = t;
+    if (fix.dof > 0 && fix.chi2 / fix.dof > options.max_chi2_per_dof) {
+      ++report->rejected;
+      continue;
+    }
+    report->fixes.push_back(fix);
+
+    Eigen::Vector3d measured =
+        Eigen::Vector3d(fix.pose.x, fix.pose.y, fix.pose.theta) - base(t);
+    measured.z() = state.z() + WrapAngle(measured.z() - state.z());
+    const double elapsed = std::abs(t - state_time);
+    state_time = t;
+    for (int k = 0; k < 3; ++k) {
+      state_variance(k) += walk(k) * elapsed;
+      if (k == 2 && !fix.has_heading) continue;
+      const double gain =
+          state_variance(k) / (state_variance(k) + fix.covariance(k, k));
+      state(k) += gain * (measured(k) - state(k));
+      state_variance(k) *= 1.0 - gain;
+    }
+  }
+  report->localized = static_cast<int>(report->fixes.size());
+  if (report->fixes.empty()) {
+    *error = prefix + "none of the " + std::to_string(report->times) +
+             " observation times could be localised against the " +
+             std::to_string(landmarks.size()) +
+             " landmark priors (too few observations of landmarks with "
+             "priors at each time, or none that fit)";
+    return nullptr;
+  }
+
+  const std::vector<Point> points = Points(dataset, report->fixes);
+  bool any_heading = false;
+  for (const PoseFix& f : report->fixes) any_heading |= f.has_heading;
+  report->heading_from_velocity = !any_heading;
+
+  if (!dead_reckoning) {
+    Series position(2), heading(1);
+    for (const Point& p : points) {
+      position.Add(p.t, {p.pose.x(), p.pose.y()},
+                   {p.variance.x(), p.variance.y()});
+      if (p.has_heading) {
+        double theta = p.pose.z();
+        if (!heading.t.empty()) {
+          theta = heading.values[0].back() +
+                  WrapAngle(theta - heading.values[0].back());
+        }
+        heading.Add(p.t, {theta}, {p.variance.z()});
+      }
+    }
+    std::vector<CubicSmoothingSpline> xy, theta;
+    if (!RobustFit(position.t, position.values, position.variances,
+                   options.position_smoothing, options, &xy, error)) {
+      *error = prefix + *error;
+      return nullptr;
+    }
+    if (any_heading) {
+      if (!RobustFit(heading.t, heading.values, heading.variances,
+                     options.heading_smoothing, options, &theta, error)) {
+        *error = prefix + *error;
+        return nullptr;
+      }
+    } else {
+      theta.emplace_back();
+    }
+    return std::make_shared<SplineMean>(xy[0], xy[1], theta[0], !any_heading);
+  }
+
+  // With odometry: smooth the correction fix - dead reckoning, which drifts
+  // slowly, and add it to dead reckoning at every node.
+  Series position(2), heading(1);
+  for (const Point& p : points) {
+    const Eigen::Vector3d base = dead_reckoning->Evaluate(p.t);
+    position.Add(p.t, {p.pose.x() - base.x(), p.pose.y() - base.y()},
+                 {p.variance.x(), p.variance.y()});
+    if (p.has_heading) {
+      heading.Add(p.t, {WrapAngle(p.pose.z() - base.z())}, {p.variance.z()});
+    }
+  }
+  std::vector<CubicSmoothingSpline> dxy, dtheta;
+  if (!RobustFit(position.t, position.values, position.variances,
+                 options.correction_smoothing, options, &dxy, error)) {
+    *error = prefix + *error;
+    return nullptr;
+  }
+  // Held at the end values outside the fixes (no extrapolation of drift).
+  auto at = [](const CubicSmoothingSpline& s, double t) {
+    return s.Evaluate(std::clamp(t, s.knots().front(), s.knots().back()));
+  };
+  if (!any_heading) {
+    // Range-only: the heading correction is the turn between the dead
+    // reckoned and the corrected direction of motion over a few seconds.
+    heading = Series(1);
+    const double half = 5.0;
+    for (const double t : position.t) {
+      const Eigen::Vector3d a = dead_reckoning->Evaluate(t - half);
+      const Eigen::Vector3d b = dead_reckoning->Evaluate(t + half);
+      const Eigen::Vector2d v_dr = b.head<2>() - a.head<2>();
+      const Eigen::Vector2d v =
+          v_dr + Eigen::Vector2d(at(dxy[0], t + half) - at(dxy[0], t - half),
+                                 at(dxy[1], t + half) - at(dxy[1], t - half));
+      if (v_dr.norm() < 0.5 || v.norm() < 0.5) continue;
+      heading.Add(t,
+                  {WrapAngle(std::atan2(v.y(), v.x()) -
+                             std::atan2(v_dr.y(), v_dr.x()))},
+                  {0.1});
+    }
+    if (heading.t.empty()) heading.Add(position.t.front(), {0.0}, {1.0});
+  }
+  if (!RobustFit(heading.t, heading.values, heading.variances,
+                 options.correction_smoothing, options, &dtheta, error)) {
+    *error = prefix + *error;
+    return nullptr;
+  }
+  std::vector<TimedPose> poses;
+  for (const TimedPose& p : dr.poses) {
+    poses.push_back({p.t, p.x + at(dxy[0], p.t), p.y + at(dxy[1], p.t),
+                     WrapAngle(p.theta + at(dtheta[0], p.t))});
+  }
+  return std::make_shared<PiecewiseLinearMean>(poses);
+}
+
+}  // namespace rff
