@@ -66,7 +66,10 @@ INSTANTIATE_TEST_SUITE_P(
         BadLandmarks{"1 0 0\n1 2 3\n",
                      "l.landmarks:2: duplicate landmark id 1"},
         BadLandmarks{"1 0 0 1 2 1\n",
-                     "l.landmarks:1: covariance is not positive"}));
+                     "l.landmarks:1: covariance is not positive"}),
+    [](const ::testing::TestParamInfo<BadLandmarks>& info) {
+      return "Case" + std::to_string(info.index);
+    });
 
 }  // namespace
 }  // namespace rff

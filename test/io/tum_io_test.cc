@@ -66,7 +66,10 @@ INSTANTIATE_TEST_SUITE_P(
         BadTum{"0 0 0 0 0 0 0 nan\n", "t.tum:1: field 8 'nan'"},
         BadTum{"0 0 0 0 0 0 0 0\n", "t.tum:1: quaternion has zero norm"},
         BadTum{"1 0 0 0 0 0 0 1\n1 0 0 0 0 0 0 1\n",
-               "t.tum:2: time 1 does not increase"}));
+               "t.tum:2: time 1 does not increase"}),
+    [](const ::testing::TestParamInfo<BadTum>& info) {
+      return "Case" + std::to_string(info.index);
+    });
 
 }  // namespace
 }  // namespace rff
