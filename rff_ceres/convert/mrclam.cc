@@ -271,14 +271,10 @@ std::string ConverterDescription(const MrclamOptions& o) {
 
 bool CheckOptions(const MrclamOptions& o, std::string* error) {
   auto positive = [&](double v, const char* name) {
-    if (v > 0.0 && std::isfinite(v)) return true;
-    *error = std::string(name) + " must be > 0, got " + FormatNumber(v);
-    return false;
+    return CheckPositiveOption(v, name, error);
   };
   auto non_negative = [&](double v, const char* name) {
-    if (v >= 0.0 && std::isfinite(v)) return true;
-    *error = std::string(name) + " must be >= 0, got " + FormatNumber(v);
-    return false;
+    return CheckNonNegativeOption(v, name, error);
   };
   if (o.robot < 1 || o.robot > kLastRobotSubject) {
     *error = "mrclam_robot must be 1..5, got " + std::to_string(o.robot);

@@ -248,14 +248,10 @@ std::string ConverterDescription(const PlazaOptions& o) {
 
 bool CheckOptions(const PlazaOptions& o, std::string* error) {
   auto positive = [&](double v, const char* name) {
-    if (v > 0.0 && std::isfinite(v)) return true;
-    *error = std::string(name) + " must be > 0, got " + FormatNumber(v);
-    return false;
+    return CheckPositiveOption(v, name, error);
   };
   auto non_negative = [&](double v, const char* name) {
-    if (v >= 0.0 && std::isfinite(v)) return true;
-    *error = std::string(name) + " must be >= 0, got " + FormatNumber(v);
-    return false;
+    return CheckNonNegativeOption(v, name, error);
   };
   if (o.name.empty()) {
     *error = "the Plaza dataset name (file prefix) is empty";

@@ -3,6 +3,7 @@
 #ifndef RFF_CERES_CONVERT_RAW_RECORDS_H_
 #define RFF_CERES_CONVERT_RAW_RECORDS_H_
 
+#include <cmath>
 #include <fstream>
 #include <string>
 #include <string_view>
@@ -55,6 +56,21 @@ inline bool ParseRawInteger(const LineReader& reader, std::string_view field,
     return false;
   }
   return true;
+}
+
+// Option checks of the converters: `value` must be finite and > 0 (>= 0);
+// otherwise `error` names the option and the value.
+inline bool CheckPositiveOption(double value, const char* name,
+                                std::string* error) {
+  if (value > 0.0 && std::isfinite(value)) return true;
+  *error = std::string(name) + " must be > 0, got " + FormatNumber(value);
+  return false;
+}
+inline bool CheckNonNegativeOption(double value, const char* name,
+                                   std::string* error) {
+  if (value >= 0.0 && std::isfinite(value)) return true;
+  *error = std::string(name) + " must be >= 0, got " + FormatNumber(value);
+  return false;
 }
 
 }  // namespace rff

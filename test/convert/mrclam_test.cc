@@ -11,6 +11,7 @@
 #include "gtest/gtest.h"
 #include "rff_ceres/io/dataset_io.h"
 #include "rff_ceres/io/text_parser.h"
+#include "test/test_files.h"
 
 namespace rff {
 namespace {
@@ -20,26 +21,9 @@ using ::testing::HasSubstr;
 // The turning radius of the hand-made run: v = 1 m/s, omega = pi/2 rad/s.
 const double kRadius = 2.0 / M_PI;
 
-std::string TempDir() {
-  const std::string dir =
-      std::string(RFF_BINARY_DIR) + "/test_tmp/mrclam_test/" +
-      ::testing::UnitTest::GetInstance()->current_test_info()->name();
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
-  return dir;
-}
-
-void WriteFile(const std::string& path, const std::string& text) {
-  std::ofstream out(path);
-  out << text;
-}
-
-std::string ReadFile(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  return buffer.str();
-}
+std::string TempDir() { return testing::TempDir("mrclam_test"); }
+using testing::ReadFile;
+using testing::WriteFile;
 
 std::string N(double v) { return FormatNumber(v); }
 

@@ -10,33 +10,16 @@
 #include "gtest/gtest.h"
 #include "rff_ceres/io/dataset_io.h"
 #include "rff_ceres/io/text_parser.h"
+#include "test/test_files.h"
 
 namespace rff {
 namespace {
 
 using ::testing::HasSubstr;
 
-// A fresh directory per test case (ctest runs the cases in parallel).
-std::string TempDir() {
-  const std::string dir =
-      std::string(RFF_BINARY_DIR) + "/test_tmp/plaza_test/" +
-      ::testing::UnitTest::GetInstance()->current_test_info()->name();
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
-  return dir;
-}
-
-void WriteFile(const std::string& path, const std::string& text) {
-  std::ofstream out(path);
-  out << text;
-}
-
-std::string ReadFile(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  return buffer.str();
-}
+std::string TempDir() { return testing::TempDir("plaza_test"); }
+using testing::ReadFile;
+using testing::WriteFile;
 
 // Composes the ODOM increments from the PRIOR_POSE (dead reckoning) and
 // returns the RMS translation error against GT_POSE at the ODOM end times,
