@@ -26,35 +26,6 @@ ErrorSummary ToDegrees(ErrorSummary summary) {
   return summary;
 }
 
-std::string JsonString(const std::string& text) {
-  std::string out = "\"";
-  for (const char c : text) {
-    switch (c) {
-      case '"':
-        out += "\\\"";
-        break;
-      case '\\':
-        out += "\\\\";
-        break;
-      case '\n':
-        out += "\\n";
-        break;
-      case '\t':
-        out += "\\t";
-        break;
-      default:
-        if (static_cast<unsigned char>(c) < 0x20) {
-          char buffer[8];
-          std::snprintf(buffer, sizeof(buffer), "\\u%04x", c);
-          out += buffer;
-        } else {
-          out += c;
-        }
-    }
-  }
-  return out + "\"";
-}
-
 // `"key": {summary}` or `"key": null, "key_reason": "..."`.
 void WriteJsonSummary(const std::string& key, const ErrorSummary& summary,
                       std::ostream* output) {
@@ -126,23 +97,7 @@ bool InterpolateTrajectory(const std::vector<TimedPose>& trajectory,
     return false;
   }
   poses->reserve(times.size());
-  for (const double t : times) {
-    // First pose strictly after t; the segment is [upper - 1, upper].
-    const auto upper = std::upper_bound(
-        trajectory.begin(), trajectory.end(), t,
-        [](double time, const TimedPose& p) { return time < p.t; });
-    if (upper == trajectory.begin()) {
-      poses->push_back(ToTimedPose(t, ToPose2(trajectory.front())));
-    } else if (upper == trajectory.end()) {
-      poses->push_back(ToTimedPose(t, ToPose2(trajectory.back())));
-    } else {
-      const TimedPose& a = *(upper - 1);
-      const TimedPose& b = *upper;
-      const double alpha = (t - a.t) / (b.t - a.t);
-      poses->push_back(
-          ToTimedPose(t, Interpolate(ToPose2(a), ToPose2(b), alpha)));
-    }
-  }
+  for (const double t : times) poses->push_back(PoseAtTime(trajectory, t));
   return true;
 }
 

@@ -4,7 +4,9 @@
 #ifndef RFF_CERES_SE2_H_
 #define RFF_CERES_SE2_H_
 
+#include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "rff_ceres/io/text_parser.h"
 #include "rff_ceres/types.h"
@@ -74,6 +76,43 @@ Pose2T<T> Interpolate(const Pose2T<T>& a, const Pose2T<T>& b, const T& alpha) {
 inline Pose2 ToPose2(const TimedPose& p) { return {p.x, p.y, p.theta}; }
 inline TimedPose ToTimedPose(double t, const Pose2& p) {
   return {t, p.x, p.y, p.theta};
+}
+
+// The pose of `trajectory` (strictly increasing times, not empty) at time t:
+// Interpolate() between the poses around t, the end pose outside the span
+// (callers that must not extrapolate check the span first).
+inline TimedPose PoseAtTime(const std::vector<TimedPose>& trajectory,
+                            double t) {
+  // First pose strictly after t; the segment is [upper - 1, upper].
+  const auto upper = std::upper_bound(
+      trajectory.begin(), trajectory.end(), t,
+      [](double time, const TimedPose& p) { return time < p.t; });
+  if (upper == trajectory.begin()) {
+    return ToTimedPose(t, ToPose2(trajectory.front()));
+  }
+  if (upper == trajectory.end()) {
+    return ToTimedPose(t, ToPose2(trajectory.back()));
+  }
+  const TimedPose& a = *(upper - 1);
+  const TimedPose& b = *upper;
+  const double alpha = (t - a.t) / (b.t - a.t);
+  return ToTimedPose(t, Interpolate(ToPose2(a), ToPose2(b), alpha));
+}
+
+// Moves (x, y, theta) along a unicycle arc: forward speed v and turn rate
+// omega held for dt seconds. Exact for any omega: the chord of the arc,
+// v dt sinc(omega dt / 2), points along the heading halfway through the turn
+// (sinc by its series near 0). theta is not wrapped.
+inline void IntegrateUnicycle(double v, double omega, double dt, double* x,
+                              double* y, double* theta) {
+  const double half = 0.5 * omega * dt;
+  const double sinc =
+      std::abs(half) < 1e-4 ? 1.0 - half * half / 6.0 : std::sin(half) / half;
+  const double chord = v * dt * sinc;
+  const double mid_heading = *theta + half;
+  *x += chord * std::cos(mid_heading);
+  *y += chord * std::sin(mid_heading);
+  *theta += omega * dt;
 }
 
 }  // namespace rff

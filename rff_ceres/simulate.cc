@@ -11,14 +11,7 @@
 #include <vector>
 
 #include "rff_ceres/io/text_parser.h"
-
-// Contracting a * b + c into one fused multiply-add rounds differently (GCC
-// and clang do it when the target has FMA); the files must not depend on it.
-#if defined(__clang__)
-#pragma STDC FP_CONTRACT OFF
-#elif defined(__GNUC__)
-#pragma GCC optimize("fp-contract=off")
-#endif
+#include "rff_ceres/se2.h"
 
 namespace rff {
 
@@ -187,12 +180,6 @@ class OptionChecker {
   bool ok_ = true;
 };
 
-// sin(h) / h, accurate near 0.
-double Sinc(double h) {
-  if (std::abs(h) < 1e-4) return 1.0 - h * h / 6.0;
-  return std::sin(h) / h;
-}
-
 // Forward speed and turn rate as functions of time.
 class Controls {
  public:
@@ -287,12 +274,9 @@ std::vector<TimedPose> SimulateTrajectory(const SimulationOptions& options) {
   poses.push_back(pose);
   for (int k = 1; k < options.num_steps; ++k) {
     const double t = (k - 1) * options.dt;
-    const double distance = controls.Speed(t) * options.dt;
-    const double turn = controls.TurnRate(t) * options.dt;
-    const double chord = distance * Sinc(0.5 * turn);
-    pose.x += chord * std::cos(pose.theta + 0.5 * turn);
-    pose.y += chord * std::sin(pose.theta + 0.5 * turn);
-    pose.theta = WrapAngle(pose.theta + turn);
+    IntegrateUnicycle(controls.Speed(t), controls.TurnRate(t), options.dt,
+                      &pose.x, &pose.y, &pose.theta);
+    pose.theta = WrapAngle(pose.theta);
     pose.t = k * options.dt;
     poses.push_back(pose);
   }

@@ -234,34 +234,23 @@ bool WriteSummaryJson(const SlamOptions& options, const SlamResult& result,
   if (!OpenForWriting(path, &out, error)) return false;
   const ceres::Solver::Summary& s = result.summary;
   const FeatureTrajectoryOptions& t = options.trajectory;
-  auto quote = [](const std::string& text) {
-    std::string q = "\"";
-    for (const char c : text) {
-      if (c == '"' || c == '\\') q += '\\';
-      if (c == '\n') {
-        q += "\\n";
-        continue;
-      }
-      q += c;
-    }
-    return q + "\"";
-  };
   out << "{\n"
-      << "  \"prior_mean\": " << quote(options.prior_mean) << ",\n"
-      << "  \"kernel\": " << quote(t.position_kernel.name) << ",\n"
-      << "  \"heading_kernel\": " << quote(t.heading_kernel.name) << ",\n"
+      << "  \"prior_mean\": " << JsonString(options.prior_mean) << ",\n"
+      << "  \"kernel\": " << JsonString(t.position_kernel.name) << ",\n"
+      << "  \"heading_kernel\": " << JsonString(t.heading_kernel.name) << ",\n"
       << "  \"lengthscale\": " << FormatNumber(t.position_kernel.lengthscale)
       << ",\n"
       << "  \"kernel_variance\": " << FormatNumber(t.position_kernel.variance)
       << ",\n"
-      << "  \"features\": " << quote(t.family) << ",\n"
+      << "  \"features\": " << JsonString(t.family) << ",\n"
       << "  \"num_features\": " << t.num_position_features << ",\n"
       << "  \"num_heading_features\": " << t.num_heading_features << ",\n"
       << "  \"seed\": " << t.seed << ",\n"
-      << "  \"loss\": " << quote(options.problem.loss.name) << ",\n"
-      << "  \"linear_solver\": " << quote(options.solver.linear_solver) << ",\n"
+      << "  \"loss\": " << JsonString(options.problem.loss.name) << ",\n"
+      << "  \"linear_solver\": " << JsonString(options.solver.linear_solver)
+      << ",\n"
       << "  \"termination\": "
-      << quote(ceres::TerminationTypeToString(s.termination_type)) << ",\n"
+      << JsonString(ceres::TerminationTypeToString(s.termination_type)) << ",\n"
       << "  \"converged\": " << (result.converged ? "true" : "false") << ",\n"
       << "  \"iterations\": " << result.total_iterations << ",\n"
       << "  \"outer_rounds\": " << options.outer_rounds << ",\n"

@@ -10,6 +10,8 @@
 
 #include "rff_ceres/convert/raw_records.h"
 #include "rff_ceres/io/text_parser.h"
+#include "rff_ceres/se2.h"
+#include "rff_ceres/statistics.h"
 
 namespace rff {
 namespace {
@@ -161,21 +163,6 @@ bool ReadMeasurements(const std::string& path, MrclamRaw* raw,
       error);
 }
 
-// Ground-truth pose at time t inside the ground-truth times: linear in
-// position, along the shorter arc in heading.
-TimedPose InterpolatePose(const std::vector<TimedPose>& gt, double t) {
-  auto upper = std::upper_bound(
-      gt.begin(), gt.end(), t,
-      [](double time, const TimedPose& p) { return time < p.t; });
-  if (upper == gt.end()) upper = gt.end() - 1;
-  if (upper == gt.begin()) upper = gt.begin() + 1;
-  const TimedPose& p0 = *(upper - 1);
-  const TimedPose& p1 = *upper;
-  const double s = (t - p0.t) / (p1.t - p0.t);
-  return {t, p0.x + s * (p1.x - p0.x), p0.y + s * (p1.y - p0.y),
-          WrapAngle(p0.theta + s * WrapAngle(p1.theta - p0.theta))};
-}
-
 // The pose times: the distinct measurement times, with each gap longer
 // than `interval` (when > 0) split into equal steps rounded to the
 // millisecond.
@@ -218,19 +205,6 @@ void IntegrateBetween(const std::vector<VelocityRow>& rows, double t0,
     }
     if (i + 1 < rows.size() && rows[i + 1].t <= now) ++i;
   }
-}
-
-double Median(std::vector<double> values) {
-  if (values.empty()) return 0.0;
-  const std::size_t mid = values.size() / 2;
-  std::nth_element(values.begin(), values.begin() + mid, values.end());
-  double median = values[mid];
-  if (values.size() % 2 == 0) {
-    median =
-        (median + *std::max_element(values.begin(), values.begin() + mid)) /
-        2.0;
-  }
-  return median;
 }
 
 // Median and median absolute deviation about the median.
@@ -304,20 +278,6 @@ bool CheckOptions(const MrclamOptions& o, std::string* error) {
 }
 
 }  // namespace
-
-void IntegrateUnicycle(double v, double omega, double dt, double* x, double* y,
-                       double* theta) {
-  // Chord of the arc: length v * dt * sinc(omega * dt / 2) along the mean
-  // heading; sinc by its series near 0 so that omega -> 0 stays exact.
-  const double half = 0.5 * omega * dt;
-  const double sinc =
-      std::abs(half) < 1e-4 ? 1.0 - half * half / 6.0 : std::sin(half) / half;
-  const double chord = v * dt * sinc;
-  const double mid_heading = *theta + half;
-  *x += chord * std::cos(mid_heading);
-  *y += chord * std::sin(mid_heading);
-  *theta += omega * dt;
-}
 
 bool ConvertMrclam(const std::string& directory, const MrclamOptions& options,
                    Dataset* dataset, MrclamSummary* summary,
@@ -413,7 +373,7 @@ bool ConvertMrclam(const std::string& directory, const MrclamOptions& options,
     dataset->odometry.push_back(odom);
   }
 
-  dataset->pose_priors.push_back({InterpolatePose(raw.ground_truth, times[0]),
+  dataset->pose_priors.push_back({PoseAtTime(raw.ground_truth, times[0]),
                                   options.first_pose_sigma_xy,
                                   options.first_pose_sigma_theta});
   // Priors only on landmarks this robot sees: an unobserved landmark would
@@ -443,7 +403,7 @@ bool ConvertMrclam(const std::string& directory, const MrclamOptions& options,
 
   std::vector<double> range_residuals, bearing_residuals;
   for (const Observation& obs : dataset->observations) {
-    const TimedPose pose = InterpolatePose(raw.ground_truth, obs.t);
+    const TimedPose pose = PoseAtTime(raw.ground_truth, obs.t);
     const auto& l = raw.landmarks.at(obs.id);
     range_residuals.push_back(obs.range -
                               std::hypot(l.first - pose.x, l.second - pose.y));

@@ -71,11 +71,6 @@ struct MrclamSummary {
   MrclamAgreement agreement;
 };
 
-// Integrates the unicycle v, omega (constant) for `dt` seconds starting at
-// heading `theta` and adds the motion to (x, y, theta). Exact for any omega.
-void IntegrateUnicycle(double v, double omega, double dt, double* x, double* y,
-                       double* theta);
-
 // Reads DIRECTORY/RobotN_*.dat, Barcodes.dat, Landmark_Groundtruth.dat and
 // fills `dataset`. Returns false with "path:line: problem" on malformed input
 // or a missing file.

@@ -8,6 +8,8 @@
 
 #include "rff_ceres/convert/raw_records.h"
 #include "rff_ceres/io/text_parser.h"
+#include "rff_ceres/se2.h"
+#include "rff_ceres/statistics.h"
 
 namespace rff {
 namespace {
@@ -133,33 +135,6 @@ bool ReadRanges(const std::string& path, PlazaRaw* raw, std::string* error) {
       error);
 }
 
-// Ground-truth position at time t (linear interpolation); t must lie within
-// the ground-truth times.
-void InterpolatePosition(const std::vector<TimedPose>& gt, double t, double* x,
-                         double* y) {
-  auto upper = std::upper_bound(
-      gt.begin(), gt.end(), t,
-      [](double time, const TimedPose& p) { return time < p.t; });
-  if (upper == gt.end()) upper = gt.end() - 1;
-  if (upper == gt.begin()) upper = gt.begin() + 1;
-  const TimedPose& p0 = *(upper - 1);
-  const TimedPose& p1 = *upper;
-  const double s = (t - p0.t) / (p1.t - p0.t);
-  *x = p0.x + s * (p1.x - p0.x);
-  *y = p0.y + s * (p1.y - p0.y);
-}
-
-// Median of `values` (reordered); the mean of the middle two for an even
-// count. `values` must not be empty.
-double Median(std::vector<double>* values) {
-  const std::size_t mid = values->size() / 2;
-  std::nth_element(values->begin(), values->begin() + mid, values->end());
-  const double upper = (*values)[mid];
-  if (values->size() % 2 == 1) return upper;
-  return 0.5 *
-         (upper + *std::max_element(values->begin(), values->begin() + mid));
-}
-
 // Least squares line truth ~ a * measured + b over the flagged pairs.
 bool FitLine(const std::vector<double>& measured,
              const std::vector<double>& truth, const std::vector<bool>& use,
@@ -209,19 +184,19 @@ bool RepeatedMedianLine(const std::vector<double>& measured,
       if (measured[j] == measured[i]) continue;
       slopes.push_back((truth[j] - truth[i]) / (measured[j] - measured[i]));
     }
-    if (!slopes.empty()) slopes_at.push_back(Median(&slopes));
+    if (!slopes.empty()) slopes_at.push_back(Median(slopes));
   }
   if (slopes_at.empty()) {
     *error = "range calibration: all measured ranges are equal";
     return false;
   }
-  *a = Median(&slopes_at);
+  *a = Median(slopes_at);
   std::vector<double> intercepts;
   intercepts.reserve(measured.size());
   for (std::size_t i = 0; i < measured.size(); ++i) {
     intercepts.push_back(truth[i] - *a * measured[i]);
   }
-  *b = Median(&intercepts);
+  *b = Median(intercepts);
   return true;
 }
 
@@ -379,12 +354,11 @@ bool ConvertPlaza(const std::string& directory, const PlazaOptions& options,
       ++summary->ranges_outside_span;
       continue;
     }
-    double x, y;
-    InterpolatePosition(gt, r.t, &x, &y);
+    const TimedPose pose = PoseAtTime(gt, r.t);
     const auto& beacon = raw.beacons.at(r.beacon);
     in_span.push_back(r);
     measured.push_back(r.range);
-    truth.push_back(std::hypot(beacon.first - x, beacon.second - y));
+    truth.push_back(std::hypot(beacon.first - pose.x, beacon.second - pose.y));
   }
   if (!FitLinearRangeCalibration(measured, truth, options.outlier_threshold,
                                  &summary->fit, error)) {

@@ -74,6 +74,10 @@ bool ParseFiniteDoubles(const LineReader& reader,
 // Shortest text that parses back to exactly `value` (std::to_chars).
 std::string FormatNumber(double value);
 
+// `text` as a JSON string literal, quotes included, with '"', '\\' and
+// control characters escaped.
+std::string JsonString(const std::string& text);
+
 // Wraps an angle to (-pi, pi].
 double WrapAngle(double angle);
 

@@ -5,6 +5,8 @@
 #include <limits>
 
 #include "Eigen/Dense"
+#include "costs/bearing_cost.h"
+#include "costs/range_cost.h"
 #include "rff_ceres/dead_reckoning.h"
 #include "rff_ceres/io/text_parser.h"
 #include "rff_ceres/mean/spline_mean.h"
@@ -27,25 +29,29 @@ std::vector<Row> Residuals(const std::vector<Observation>& observations,
   std::vector<Row> rows;
   for (const Observation& o : observations) {
     const KnownLandmark& l = landmarks.at(o.id);
-    const Eigen::Vector2d d = l.position - p.head<2>();
-    const double distance = std::max(d.norm(), 1e-6);
+    // The measurement models of the solver's costs (costs/range_cost.h,
+    // costs/bearing_cost.h), with the landmark's prior spread added.
+    double range;
+    Eigen::Vector3d d_pose;
+    Eigen::Vector2d d_landmark;
+    RangeAndGradient(p, l.position, &range, &d_pose, &d_landmark);
     if (o.HasRange()) {
       const double sigma =
           std::sqrt(o.sigma_range * o.sigma_range + l.sigma * l.sigma);
       Row row;
-      row.residual = (distance - o.range) / sigma;
-      row.jacobian << -d.x() / distance / sigma, -d.y() / distance / sigma, 0.0;
+      row.residual = (range - o.range) / sigma;
+      row.jacobian = d_pose.transpose() / sigma;
       rows.push_back(row);
     }
-    if (o.HasBearing()) {
-      const double spread = l.sigma / distance;
+    double bearing;
+    if (o.HasBearing() &&
+        BearingAndGradient(p, l.position, &bearing, &d_pose, &d_landmark)) {
+      const double spread = l.sigma / std::max(range, 1e-6);
       const double sigma =
           std::sqrt(o.sigma_bearing * o.sigma_bearing + spread * spread);
-      const double d2 = distance * distance;
       Row row;
-      row.residual =
-          WrapAngle(std::atan2(d.y(), d.x()) - p.z() - o.bearing) / sigma;
-      row.jacobian << d.y() / d2 / sigma, -d.x() / d2 / sigma, -1.0 / sigma;
+      row.residual = WrapAngle(bearing - o.bearing) / sigma;
+      row.jacobian = d_pose.transpose() / sigma;
       rows.push_back(row);
     }
   }

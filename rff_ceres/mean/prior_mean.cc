@@ -39,8 +39,8 @@ std::string NameList() {
 std::shared_ptr<const MeanFunction> BuildPriorMean(const std::string& name,
                                                    const Dataset& dataset,
                                                    std::string* error) {
-  if (name != "odometry" && name != "localization" && name != "spline" &&
-      name != "constant" && name != "auto") {
+  const std::vector<std::string> names = PriorMeanNames();
+  if (std::find(names.begin(), names.end(), name) == names.end()) {
     *error = "unknown prior mean '" + name + "' (expected " + NameList() + ")";
     return nullptr;
   }

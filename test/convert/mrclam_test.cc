@@ -11,6 +11,7 @@
 #include "gtest/gtest.h"
 #include "rff_ceres/io/dataset_io.h"
 #include "rff_ceres/io/text_parser.h"
+#include "rff_ceres/se2.h"
 #include "test/test_files.h"
 
 namespace rff {
