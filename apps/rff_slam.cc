@@ -18,6 +18,7 @@
 #include "rff_ceres/io/tum_io.h"
 #include "rff_ceres/metrics.h"
 #include "rff_ceres/slam_solver.h"
+#include "slam_flags.h"
 
 DEFINE_string(dataset, "", "Input dataset (.rffd).");
 DEFINE_string(output_trajectory, "", "Write the trajectory here (TUM).");
@@ -26,113 +27,11 @@ DEFINE_string(summary_json, "", "Write the solve summary here (JSON).");
 DEFINE_bool(evaluate, true,
             "Print APE/RPE/landmark errors when the dataset has ground truth.");
 
-// Trajectory prior.
-DEFINE_string(prior_mean, "auto", "Prior mean: auto, odometry or constant.");
-DEFINE_string(kernel, "rbf",
-              "Kernel of x and y: rbf, matern12, matern32, matern52, "
-              "periodic.");
-DEFINE_string(heading_kernel, "", "Kernel of theta (default: --kernel).");
-DEFINE_double(lengthscale, 10.0, "Kernel lengthscale of x and y (seconds).");
-DEFINE_double(heading_lengthscale, 0.0,
-              "Kernel lengthscale of theta (0: --lengthscale).");
-DEFINE_double(kernel_variance, 4.0,
-              "Kernel variance of x and y (m^2): the prior spread of the "
-              "trajectory around its mean.");
-DEFINE_double(heading_kernel_variance, 0.1,
-              "Kernel variance of theta (rad^2).");
-DEFINE_double(period, 1.0, "Period of the periodic kernel (seconds).");
-DEFINE_string(features, "hilbert",
-              "Feature family: rff, qmc, gauss_hermite, hilbert.");
-DEFINE_int32(num_features, 100, "Features per coordinate of x and y (D).");
-DEFINE_int32(num_heading_features, 0, "Features of theta (0: --num_features).");
-DEFINE_uint64(seed, 1, "Seed of the random feature frequencies.");
-DEFINE_double(segment_length, 0.0,
-              "Windowed weights: segment length in seconds (0: one global "
-              "feature map over the whole run).");
-DEFINE_double(segment_overlap, 0.0,
-              "Windowed weights: blend overlap between segments (seconds).");
-
-DEFINE_int32(outer_rounds, 0,
-             "Smoothing-spline prior rounds (paper III-B.2): refit the mean "
-             "to the estimate and re-solve this many times.");
-DEFINE_double(spline_smoothing, 0.98,
-              "Smoothing parameter p of the spline mean (De Boor).");
-
-// Problem.
-DEFINE_string(loss, "none",
-              "Robust loss on observations: none, huber, cauchy.");
-DEFINE_double(loss_scale, 1.0, "Robust loss scale, in sigmas.");
-DEFINE_bool(use_odometry, true, "Add the ODOM records as residuals.");
-DEFINE_bool(preintegrate_odometry, true,
-            "Compose ODOM chains between observation times into one residual "
-            "each (first-order covariance).");
-DEFINE_double(max_preintegration_seconds, 1.0,
-              "Longest time one preintegrated odometry chain may span.");
-
-// Ceres.
-DEFINE_string(linear_solver, "DENSE_SCHUR",
-              "Ceres linear solver: DENSE_SCHUR, SPARSE_SCHUR, "
-              "ITERATIVE_SCHUR, DENSE_QR, SPARSE_NORMAL_CHOLESKY, CGNR, ...");
-DEFINE_string(preconditioner, "auto",
-              "Ceres preconditioner of ITERATIVE_SCHUR and CGNR: IDENTITY, "
-              "JACOBI, SCHUR_JACOBI, CLUSTER_JACOBI, CLUSTER_TRIDIAGONAL; "
-              "auto picks SCHUR_JACOBI, or JACOBI for CGNR.");
-DEFINE_string(trust_region_strategy, "LEVENBERG_MARQUARDT",
-              "LEVENBERG_MARQUARDT or DOGLEG.");
-DEFINE_int32(num_threads, 2, "Threads for Jacobians and linear algebra.");
-DEFINE_int32(max_iterations, 100, "Maximum number of solver iterations.");
-DEFINE_double(function_tolerance, 1e-8, "Ceres function tolerance.");
-DEFINE_double(gradient_tolerance, 1e-10, "Ceres gradient tolerance.");
-DEFINE_double(parameter_tolerance, 1e-8, "Ceres parameter tolerance.");
-
 namespace {
 
 int Fail(const std::string& message) {
   std::cerr << "rff_slam: error: " << message << "\n";
   return 1;
-}
-
-rff::SlamOptions OptionsFromFlags() {
-  rff::SlamOptions options;
-  options.prior_mean = FLAGS_prior_mean;
-  options.outer_rounds = FLAGS_outer_rounds;
-  options.spline_smoothing = FLAGS_spline_smoothing;
-  rff::FeatureTrajectoryOptions& t = options.trajectory;
-  t.position_kernel.name = FLAGS_kernel;
-  t.position_kernel.lengthscale = FLAGS_lengthscale;
-  t.position_kernel.variance = FLAGS_kernel_variance;
-  t.position_kernel.period = FLAGS_period;
-  t.heading_kernel = t.position_kernel;
-  if (!FLAGS_heading_kernel.empty())
-    t.heading_kernel.name = FLAGS_heading_kernel;
-  if (FLAGS_heading_lengthscale != 0.0) {
-    t.heading_kernel.lengthscale = FLAGS_heading_lengthscale;
-  }
-  t.heading_kernel.variance = FLAGS_heading_kernel_variance;
-  t.family = FLAGS_features;
-  t.num_position_features = FLAGS_num_features;
-  t.num_heading_features = FLAGS_num_heading_features != 0
-                               ? FLAGS_num_heading_features
-                               : FLAGS_num_features;
-  t.seed = FLAGS_seed;
-  t.segment_length = FLAGS_segment_length;
-  t.segment_overlap = FLAGS_segment_overlap;
-  options.problem.loss.name = FLAGS_loss;
-  options.problem.loss.scale = FLAGS_loss_scale;
-  options.problem.use_odometry = FLAGS_use_odometry;
-  options.problem.preintegrate_odometry = FLAGS_preintegrate_odometry;
-  options.problem.max_preintegration_seconds = FLAGS_max_preintegration_seconds;
-  rff::SolverOptions& s = options.solver;
-  s.linear_solver = FLAGS_linear_solver;
-  s.preconditioner = FLAGS_preconditioner;
-  s.trust_region_strategy = FLAGS_trust_region_strategy;
-  s.num_threads = FLAGS_num_threads;
-  s.max_iterations = FLAGS_max_iterations;
-  s.function_tolerance = FLAGS_function_tolerance;
-  s.gradient_tolerance = FLAGS_gradient_tolerance;
-  s.parameter_tolerance = FLAGS_parameter_tolerance;
-  s.log_progress = true;
-  return options;
 }
 
 }  // namespace
@@ -153,7 +52,7 @@ int main(int argc, char** argv) {
   std::string error;
   rff::Dataset dataset;
   if (!rff::ReadDataset(FLAGS_dataset, &dataset, &error)) return Fail(error);
-  const rff::SlamOptions options = OptionsFromFlags();
+  const rff::SlamOptions options = rff::SlamOptionsFromFlags();
   rff::SlamResult result;
   if (!rff::RunSlam(dataset, options, &result, &error)) {
     return Fail(FLAGS_dataset + ": " + error);

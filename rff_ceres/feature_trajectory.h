@@ -62,8 +62,8 @@ class FeatureTrajectory : public TrajectoryModel {
   void AddPriorCosts(ceres::Problem* problem) override;
 
   double origin() const { return origin_; }
-  const MeanFunction& mean() const { return *mean_; }
-  void set_mean(std::shared_ptr<const MeanFunction> mean) {
+  const MeanFunction& mean() const override { return *mean_; }
+  void set_mean(std::shared_ptr<const MeanFunction> mean) override {
     mean_ = std::move(mean);
   }
 

@@ -6,12 +6,14 @@
 #ifndef RFF_CERES_TRAJECTORY_MODEL_H_
 #define RFF_CERES_TRAJECTORY_MODEL_H_
 
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "Eigen/Core"
 #include "ceres/problem.h"
 #include "costs/pose_map.h"
+#include "rff_ceres/mean/mean_function.h"
 
 namespace rff {
 
@@ -32,6 +34,11 @@ class TrajectoryModel {
 
   // Adds the prior over the blocks (whitened weights, GP motion prior).
   virtual void AddPriorCosts(ceres::Problem* problem) = 0;
+
+  // The prior mean mu(t) the blocks deviate from; replaced between the outer
+  // rounds of the smoothing-spline prior (paper III-B.2).
+  virtual const MeanFunction& mean() const = 0;
+  virtual void set_mean(std::shared_ptr<const MeanFunction> mean) = 0;
 
   // Heading and position at t with the current block values (heading not
   // wrapped: the model's heading is a continuous function of time).

@@ -1,0 +1,16 @@
+// The solver flags of rff_slam, defined once and shared with rff_experiment
+// (which reads one flagfile per method): the flag names, defaults and help
+// texts are the same in every tool.
+#ifndef RFF_APPS_SLAM_FLAGS_H_
+#define RFF_APPS_SLAM_FLAGS_H_
+
+#include "rff_ceres/slam_solver.h"
+
+namespace rff {
+
+// SlamOptions from the current values of the solver flags.
+SlamOptions SlamOptionsFromFlags();
+
+}  // namespace rff
+
+#endif  // RFF_APPS_SLAM_FLAGS_H_
