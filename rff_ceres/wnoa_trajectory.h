@@ -10,13 +10,16 @@
 // is the residual
 //
 //   e_i = gamma_{i+1} - Phi(dt) gamma_i,   e_i ~ N(0, Q_i(dt)),
-//   Phi = [1 dt; 0 1],  Q_i = Q_c [dt^3/3 dt^2/2; dt^2/2 dt]   (per coordinate),
+//   Phi = [1 dt; 0 1],  Q_i = Q_c [dt^3/3 dt^2/2; dt^2/2 dt]
+//
+// per coordinate,
 //
 // and the pose at any time tau in [t_i, t_{i+1}] is the GP interpolation
 // (Barfoot et al. 2014, eq. 10; Anderson et al. 2015)
 //
 //   p(tau) = Lambda(tau) gamma_i + Psi(tau) gamma_{i+1},
-//   Psi = Q_tau Phi(t_{i+1}, tau)^T Q_i^-1,  Lambda = Phi(tau, t_i) - Psi Phi(dt),
+//   Psi = Q_tau Phi(t_{i+1}, tau)^T Q_i^-1,
+//   Lambda = Phi(tau, t_i) - Psi Phi(dt),
 //
 // which is affine in two blocks, so every observation cost of the RFF model
 // serves this model unchanged through its PoseMap. Before t_0 and after t_K
@@ -24,6 +27,8 @@
 #ifndef RFF_CERES_WNOA_TRAJECTORY_H_
 #define RFF_CERES_WNOA_TRAJECTORY_H_
 
+#include <array>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -62,7 +67,7 @@ class WnoaTrajectory : public TrajectoryModel {
       std::vector<double> state_times, std::string* error);
 
   int num_blocks() const override;
-  int block_size(int block) const override { return kStateSize; }
+  int block_size(int /*block*/) const override { return kStateSize; }
   double* mutable_block(int block) override;
   PoseMap PoseAt(double t) const override;
   // The initial-state prior on block 0 and one WnoaPriorCost between every
@@ -73,9 +78,34 @@ class WnoaTrajectory : public TrajectoryModel {
 
   const std::vector<double>& state_times() const;
 
+  // The per-coordinate 2x2 interpolation matrices at `elapsed` = tau - t_i
+  // in an interval of length `dt` = t_{i+1} - t_i > 0, in closed form
+  // (cubic Hermite basis in s = elapsed / dt; Q_c cancels out):
+  //   (p, v)(tau) = lambda (p_i, v_i) + psi (p_{i+1}, v_{i+1}).
+  static void InterpolationMatrices(double elapsed, double dt,
+                                    Eigen::Matrix2d* lambda,
+                                    Eigen::Matrix2d* psi);
+
  private:
   WnoaTrajectory() = default;
-  // Implementation details are the implementer's choice.
+
+  // The blocks and per-coordinate phi vectors that give the pose at one time.
+  struct Interpolation {
+    int num_blocks = 0;  // 1 (at a state time or outside the span) or 2.
+    std::array<int, 2> blocks = {0, 0};
+    // phi[k][c]: coordinate c's 6-vector on blocks[k].
+    std::array<std::array<std::shared_ptr<const Eigen::VectorXd>, 3>, 2> phi;
+  };
+  const Interpolation& InterpolationAt(double t) const;
+
+  WnoaOptions options_;
+  std::shared_ptr<const MeanFunction> mean_;
+  std::vector<double> times_;   // Sorted, thinned state times.
+  std::vector<double> states_;  // kStateSize values per state, contiguous.
+  // e_c, shared by the poses at every state time.
+  std::array<std::shared_ptr<const Eigen::VectorXd>, 3> unit_phi_;
+  // Observations at the same time share their phi vectors.
+  mutable std::map<double, Interpolation> cache_;
 };
 
 }  // namespace rff

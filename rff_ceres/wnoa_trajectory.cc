@@ -1,0 +1,181 @@
+#include "rff_ceres/wnoa_trajectory.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "costs/wnoa_initial_state_cost.h"
+#include "costs/wnoa_prior_cost.h"
+#include "rff_ceres/io/text_parser.h"
+
+namespace rff {
+namespace {
+
+bool CheckPositive(const char* name, double value, std::string* error) {
+  if (std::isfinite(value) && value > 0.0) return true;
+  *error =
+      std::string("wnoa ") + name + " must be > 0, got " + FormatNumber(value);
+  return false;
+}
+
+// The 6-vector that reads a * p_c + b * v_c from a state.
+std::shared_ptr<const Eigen::VectorXd> RowPhi(int coordinate, double a,
+                                              double b) {
+  auto phi = std::make_shared<Eigen::VectorXd>(
+      Eigen::VectorXd::Zero(WnoaTrajectory::kStateSize));
+  (*phi)(coordinate) = a;
+  (*phi)(coordinate + 3) = b;
+  return phi;
+}
+
+}  // namespace
+
+std::unique_ptr<WnoaTrajectory> WnoaTrajectory::Create(
+    const WnoaOptions& options, std::shared_ptr<const MeanFunction> mean,
+    std::vector<double> state_times, std::string* error) {
+  if (!CheckPositive("position_qc", options.position_qc, error) ||
+      !CheckPositive("heading_qc", options.heading_qc, error) ||
+      !CheckPositive("initial_position_sigma", options.initial_position_sigma,
+                     error) ||
+      !CheckPositive("initial_heading_sigma", options.initial_heading_sigma,
+                     error) ||
+      !CheckPositive("initial_velocity_sigma", options.initial_velocity_sigma,
+                     error) ||
+      !CheckPositive("initial_angular_velocity_sigma",
+                     options.initial_angular_velocity_sigma, error)) {
+    return nullptr;
+  }
+  if (!(std::isfinite(options.min_state_spacing) &&
+        options.min_state_spacing >= 0.0)) {
+    *error = "wnoa min_state_spacing must be finite and >= 0, got " +
+             FormatNumber(options.min_state_spacing);
+    return nullptr;
+  }
+  if (!mean) {
+    *error = "wnoa needs a prior mean, got none";
+    return nullptr;
+  }
+  if (state_times.empty()) {
+    *error = "wnoa needs at least one state time, got none";
+    return nullptr;
+  }
+  for (const double t : state_times) {
+    if (!std::isfinite(t)) {
+      *error = "wnoa state times must be finite, got " + FormatNumber(t);
+      return nullptr;
+    }
+  }
+  std::sort(state_times.begin(), state_times.end());
+  state_times.erase(std::unique(state_times.begin(), state_times.end()),
+                    state_times.end());
+
+  std::unique_ptr<WnoaTrajectory> model(new WnoaTrajectory);
+  model->options_ = options;
+  model->mean_ = std::move(mean);
+  // The first time of each cluster is kept: kept times are at least
+  // min_state_spacing apart (the last time too, or it is dropped).
+  for (const double t : state_times) {
+    if (model->times_.empty() ||
+        t - model->times_.back() >= options.min_state_spacing) {
+      model->times_.push_back(t);
+    }
+  }
+  model->states_.assign(kStateSize * model->times_.size(), 0.0);
+  for (int c = 0; c < 3; ++c) model->unit_phi_[c] = RowPhi(c, 1.0, 0.0);
+  return model;
+}
+
+int WnoaTrajectory::num_blocks() const {
+  return static_cast<int>(times_.size());
+}
+
+double* WnoaTrajectory::mutable_block(int block) {
+  return states_.data() + kStateSize * block;
+}
+
+const MeanFunction& WnoaTrajectory::mean() const { return *mean_; }
+
+void WnoaTrajectory::set_mean(std::shared_ptr<const MeanFunction> mean) {
+  mean_ = std::move(mean);
+}
+
+const std::vector<double>& WnoaTrajectory::state_times() const {
+  return times_;
+}
+
+void WnoaTrajectory::InterpolationMatrices(double elapsed, double dt,
+                                           Eigen::Matrix2d* lambda,
+                                           Eigen::Matrix2d* psi) {
+  // Psi = Q_tau Phi(t_{i+1}, tau)^T Q_i^-1 and Lambda = Phi(tau, t_i) -
+  // Psi Phi(dt) multiplied out: the cubic Hermite basis, with no inverse of
+  // the ill-conditioned Q_i.
+  const double s = elapsed / dt;
+  const double r = 1.0 - s;
+  const double h01 = s * s * (3.0 - 2.0 * s);
+  *lambda << 1.0 - h01, elapsed * r * r, -6.0 * s * r / dt, r * (1.0 - 3.0 * s);
+  *psi << h01, -elapsed * s * r, 6.0 * s * r / dt, s * (3.0 * s - 2.0);
+}
+
+const WnoaTrajectory::Interpolation& WnoaTrajectory::InterpolationAt(
+    double t) const {
+  auto it = cache_.find(t);
+  if (it != cache_.end()) return it->second;
+  Interpolation interpolation;
+  // Only differences of nearby times enter the coefficients, computed from
+  // the raw times: as precise as shifting to t_0 first, and exact at t_i.
+  const int last = num_blocks() - 1;
+  const auto upper = std::upper_bound(times_.begin(), times_.end(), t);
+  const int i = static_cast<int>(upper - times_.begin()) - 1;
+  if (i < 0 || i >= last || t == times_[i]) {
+    // Outside the span: constant velocity from the nearest end state, p +
+    // (t - t_end) v; at a state time that is the state's position alone.
+    const int block = i < 0 ? 0 : i;
+    const double elapsed = t - times_[block];
+    interpolation.num_blocks = 1;
+    interpolation.blocks[0] = block;
+    for (int c = 0; c < 3; ++c) {
+      interpolation.phi[0][c] =
+          elapsed == 0.0 ? unit_phi_[c] : RowPhi(c, 1.0, elapsed);
+    }
+  } else {
+    Eigen::Matrix2d lambda, psi;
+    InterpolationMatrices(t - times_[i], times_[i + 1] - times_[i], &lambda,
+                          &psi);
+    interpolation.num_blocks = 2;
+    interpolation.blocks = {i, i + 1};
+    for (int c = 0; c < 3; ++c) {
+      interpolation.phi[0][c] = RowPhi(c, lambda(0, 0), lambda(0, 1));
+      interpolation.phi[1][c] = RowPhi(c, psi(0, 0), psi(0, 1));
+    }
+  }
+  return cache_.emplace(t, std::move(interpolation)).first->second;
+}
+
+PoseMap WnoaTrajectory::PoseAt(double t) const {
+  PoseMap map;
+  map.mean = mean_->Evaluate(t);
+  const Interpolation& interpolation = InterpolationAt(t);
+  for (int k = 0; k < interpolation.num_blocks; ++k) {
+    for (int c = 0; c < 3; ++c) {
+      map.terms.push_back(
+          {interpolation.blocks[k], c, interpolation.phi[k][c]});
+    }
+  }
+  return map;
+}
+
+void WnoaTrajectory::AddPriorCosts(ceres::Problem* problem) {
+  WnoaInitialStateCost::Vector6 sigma;
+  sigma << options_.initial_position_sigma, options_.initial_position_sigma,
+      options_.initial_heading_sigma, options_.initial_velocity_sigma,
+      options_.initial_velocity_sigma, options_.initial_angular_velocity_sigma;
+  problem->AddResidualBlock(new WnoaInitialStateCost(sigma), nullptr,
+                            mutable_block(0));
+  for (int i = 0; i + 1 < num_blocks(); ++i) {
+    problem->AddResidualBlock(
+        new WnoaPriorCost(times_[i + 1] - times_[i], options_.position_qc,
+                          options_.position_qc, options_.heading_qc),
+        nullptr, mutable_block(i), mutable_block(i + 1));
+  }
+}
+
+}  // namespace rff
