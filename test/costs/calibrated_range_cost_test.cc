@@ -1,0 +1,78 @@
+#include "costs/calibrated_range_cost.h"
+
+#include "costs/diagonal_prior_cost.h"
+#include "test/costs/cost_test_util.h"
+
+namespace rff {
+namespace {
+
+using testing::PoseOf;
+
+// Independent twin: (s |l - p| + o - z) / sigma.
+struct CalibratedRangeAutoDiff {
+  PoseMap map;
+  double range, sigma;
+  int landmark_block;
+  template <typename T>
+  bool operator()(T const* const* p, T* r) const {
+    const auto pose = PoseOf(map, p);
+    const T dx = p[landmark_block][0] - pose[0];
+    const T dy = p[landmark_block][1] - pose[1];
+    const T* calibration = p[landmark_block + 1];
+    r[0] = (calibration[0] * sqrt(dx * dx + dy * dy) + calibration[1] - range) /
+           sigma;
+    return true;
+  }
+};
+
+TEST(CalibratedRangeCostTest, AnalyticJacobianMatchesAutoDiff) {
+  std::mt19937 rng(3);
+  for (int trial = 0; trial < 20; ++trial) {
+    const PoseMap map = testing::RandomPoseMap(&rng);
+    const CalibratedRangeCost cost(map, 6.1, 0.4);
+    auto autodiff = testing::MakeAutoDiff(
+        new CalibratedRangeAutoDiff{map, 6.1, 0.4, 3}, cost);
+    auto parameters =
+        testing::RandomParameters(cost.parameter_block_sizes(), &rng);
+    parameters[3] = {8.0 - trial, 5.0 + 0.2 * trial};
+    parameters[4] = {1.0 + 0.01 * trial, 0.3 - 0.05 * trial};
+    testing::ExpectSameCost(cost, *autodiff, parameters);
+  }
+}
+
+TEST(CalibratedRangeCostTest, ResidualAppliesScaleAndOffset) {
+  // Pose (1, 2) from one block with phi = (1) and b = 0; landmark at
+  // distance 5; model 1.1 * 5 + 0.2 = 5.7 against a reading of 5.2.
+  PoseMap map;
+  map.mean << 1.0, 2.0, 0.0;
+  map.terms.push_back(
+      {0, 0, std::make_shared<Eigen::VectorXd>(Eigen::VectorXd::Ones(1))});
+  const CalibratedRangeCost cost(map, 5.2, 0.5);
+  const double b[1] = {0.0};
+  const double l[2] = {4.0, 6.0};
+  const double c[2] = {1.1, 0.2};
+  const double* parameters[3] = {b, l, c};
+  double r;
+  ASSERT_TRUE(cost.Evaluate(parameters, &r, nullptr));
+  EXPECT_NEAR(r, (5.7 - 5.2) / 0.5, 1e-12);
+}
+
+TEST(DiagonalPriorCostTest, ResidualAndJacobian) {
+  const DiagonalPriorCost cost(Eigen::Vector2d(1.0, 0.0),
+                               Eigen::Vector2d(0.1, 2.0));
+  const double x[2] = {1.05, -1.0};
+  const double* parameters[1] = {x};
+  double r[2];
+  double j[4];
+  double* jacobians[1] = {j};
+  ASSERT_TRUE(cost.Evaluate(parameters, r, jacobians));
+  EXPECT_NEAR(r[0], 0.5, 1e-12);
+  EXPECT_NEAR(r[1], -0.5, 1e-12);
+  EXPECT_DOUBLE_EQ(j[0], 10.0);
+  EXPECT_DOUBLE_EQ(j[1], 0.0);
+  EXPECT_DOUBLE_EQ(j[2], 0.0);
+  EXPECT_DOUBLE_EQ(j[3], 0.5);
+}
+
+}  // namespace
+}  // namespace rff
