@@ -15,6 +15,7 @@
 #include "rff_ceres/features/feature_map.h"
 #include "rff_ceres/io/dataset_io.h"
 #include "rff_ceres/io/landmarks_io.h"
+#include "rff_ceres/io/pose_covariance_io.h"
 #include "rff_ceres/io/tum_io.h"
 #include "rff_ceres/metrics.h"
 #include "rff_ceres/slam_solver.h"
@@ -23,6 +24,10 @@
 DEFINE_string(dataset, "", "Input dataset (.rffd).");
 DEFINE_string(output_trajectory, "", "Write the trajectory here (TUM).");
 DEFINE_string(output_landmarks, "", "Write the landmarks here (.landmarks).");
+DEFINE_string(output_covariance, "",
+              "Write the covariance of each output pose here (t sxx sxy sxt "
+              "syy syt stt per line); the landmarks file then carries "
+              "sxx sxy syy.");
 DEFINE_string(summary_json, "", "Write the solve summary here (JSON).");
 DEFINE_bool(evaluate, true,
             "Print APE/RPE/landmark errors when the dataset has ground truth.");
@@ -52,32 +57,15 @@ int main(int argc, char** argv) {
   std::string error;
   rff::Dataset dataset;
   if (!rff::ReadDataset(FLAGS_dataset, &dataset, &error)) return Fail(error);
-  const rff::SlamOptions options = rff::SlamOptionsFromFlags();
+  rff::SlamOptions options = rff::SlamOptionsFromFlags();
+  options.compute_covariance = !FLAGS_output_covariance.empty();
   rff::SlamResult result;
   if (!rff::RunSlam(dataset, options, &result, &error)) {
     return Fail(FLAGS_dataset + ": " + error);
   }
 
-  const ceres::Solver::Summary& s = result.summary;
-  std::cout << "rff_slam: " << FLAGS_dataset << "\n"
-            << "  model        " << options.trajectory.family << " features, "
-            << options.trajectory.position_kernel.name
-            << " kernel, D = " << options.trajectory.num_position_features
-            << " (x, y), " << options.trajectory.num_heading_features
-            << " (theta)\n"
-            << "  problem      " << s.num_residual_blocks
-            << " residual blocks, " << s.num_parameters << " parameters\n"
-            << "  solver       " << options.solver.linear_solver << ", "
-            << result.total_iterations << " iterations, "
-            << ceres::TerminationTypeToString(s.termination_type) << "\n"
-            << "  cost         " << s.initial_cost << " -> " << s.final_cost
-            << "\n"
-            << "  time         " << s.total_time_in_seconds << " s in Ceres, "
-            << result.solve_seconds << " s total\n";
-  if (!result.converged) {
-    std::cout << "  warning: the solver stopped before convergence: "
-              << s.message << "\n";
-  }
+  std::cout << "rff_slam: " << FLAGS_dataset << "\n";
+  rff::PrintSlamSummary(options, result, &std::cout);
 
   if (!FLAGS_output_trajectory.empty() &&
       !rff::WriteTum(result.trajectory, FLAGS_output_trajectory, &error)) {
@@ -85,6 +73,11 @@ int main(int argc, char** argv) {
   }
   if (!FLAGS_output_landmarks.empty() &&
       !rff::WriteLandmarks(result.landmarks, FLAGS_output_landmarks, &error)) {
+    return Fail(error);
+  }
+  if (!FLAGS_output_covariance.empty() &&
+      !rff::WritePoseCovariances(result.trajectory, result.pose_covariances,
+                                 FLAGS_output_covariance, &error)) {
     return Fail(error);
   }
   if (!FLAGS_summary_json.empty() &&

@@ -3,7 +3,12 @@
 #include "gflags/gflags.h"
 
 // Trajectory prior.
-DEFINE_string(prior_mean, "auto", "Prior mean: auto, odometry, localization, spline or constant.");
+DEFINE_string(prior, "rff",
+              "Trajectory prior: rff (weight-space GP features, the paper's "
+              "method) or wnoa (LTV-SDE white-noise-on-acceleration states, "
+              "the gpslam baseline).");
+DEFINE_string(prior_mean, "auto",
+              "Prior mean: auto, odometry, localization, spline or constant.");
 DEFINE_string(kernel, "rbf",
               "Kernel of x and y: rbf, matern12, matern32, matern52, "
               "periodic.");
@@ -28,6 +33,34 @@ DEFINE_double(segment_length, 0.0,
 DEFINE_double(segment_overlap, 0.0,
               "Windowed weights: blend overlap between segments (seconds).");
 
+// WNOA (LTV-SDE) prior.
+DEFINE_double(wnoa_position_qc, 1.0,
+              "WNOA: power spectral density Q_c of the x and y acceleration "
+              "(m^2/s^3).");
+DEFINE_double(wnoa_heading_qc, 0.1,
+              "WNOA: Q_c of the heading acceleration (rad^2/s^3).");
+DEFINE_double(wnoa_initial_position_sigma, 10.0,
+              "WNOA: prior sigma of the first state's position deviation (m).");
+DEFINE_double(
+    wnoa_initial_heading_sigma, 1.0,
+    "WNOA: prior sigma of the first state's heading deviation (rad).");
+DEFINE_double(wnoa_initial_velocity_sigma, 1.0,
+              "WNOA: prior sigma of the first state's velocity (m/s).");
+DEFINE_double(wnoa_initial_angular_velocity_sigma, 1.0,
+              "WNOA: prior sigma of the first state's angular velocity "
+              "(rad/s).");
+DEFINE_double(wnoa_min_state_spacing, 0.0,
+              "WNOA: merge states closer than this (seconds); 0 keeps one "
+              "per observation time.");
+
+// Incremental mode.
+DEFINE_int32(incremental_every, 0,
+             "Incremental mode: feed measurements in time order and re-solve "
+             "after every K new range/bearing measurements (0: batch).");
+DEFINE_double(incremental_lag, 0.0,
+              "Incremental mode: freeze trajectory blocks untouched for this "
+              "many seconds (0: never freeze).");
+
 DEFINE_int32(outer_rounds, 0,
              "Smoothing-spline prior rounds (paper III-B.2): refit the mean "
              "to the estimate and re-solve this many times.");
@@ -38,6 +71,13 @@ DEFINE_double(spline_smoothing, 0.98,
 DEFINE_string(loss, "none",
               "Robust loss on observations: none, huber, cauchy.");
 DEFINE_double(loss_scale, 1.0, "Robust loss scale, in sigmas.");
+DEFINE_bool(estimate_range_calibration, false,
+            "Estimate a range sensor model scale * distance + offset jointly "
+            "(one per run), for ranges with a systematic bias.");
+DEFINE_double(range_scale_sigma, 0.1,
+              "Prior sigma of the range scale around 1.");
+DEFINE_double(range_offset_sigma, 1.0,
+              "Prior sigma of the range offset around 0 (m).");
 DEFINE_bool(use_odometry, true, "Add the ODOM records as residuals.");
 DEFINE_bool(preintegrate_odometry, true,
             "Compose ODOM chains between observation times into one residual "
@@ -65,7 +105,18 @@ namespace rff {
 
 SlamOptions SlamOptionsFromFlags() {
   SlamOptions options;
+  options.prior = FLAGS_prior;
   options.prior_mean = FLAGS_prior_mean;
+  WnoaOptions& w = options.wnoa;
+  w.position_qc = FLAGS_wnoa_position_qc;
+  w.heading_qc = FLAGS_wnoa_heading_qc;
+  w.initial_position_sigma = FLAGS_wnoa_initial_position_sigma;
+  w.initial_heading_sigma = FLAGS_wnoa_initial_heading_sigma;
+  w.initial_velocity_sigma = FLAGS_wnoa_initial_velocity_sigma;
+  w.initial_angular_velocity_sigma = FLAGS_wnoa_initial_angular_velocity_sigma;
+  w.min_state_spacing = FLAGS_wnoa_min_state_spacing;
+  options.incremental.every = FLAGS_incremental_every;
+  options.incremental.lag = FLAGS_incremental_lag;
   options.outer_rounds = FLAGS_outer_rounds;
   options.spline_smoothing = FLAGS_spline_smoothing;
   FeatureTrajectoryOptions& t = options.trajectory;
@@ -91,6 +142,10 @@ SlamOptions SlamOptionsFromFlags() {
   options.problem.loss.name = FLAGS_loss;
   options.problem.loss.scale = FLAGS_loss_scale;
   options.problem.use_odometry = FLAGS_use_odometry;
+  RangeCalibrationOptions& calibration = options.problem.range_calibration;
+  calibration.estimate = FLAGS_estimate_range_calibration;
+  calibration.scale_sigma = FLAGS_range_scale_sigma;
+  calibration.offset_sigma = FLAGS_range_offset_sigma;
   options.problem.preintegrate_odometry = FLAGS_preintegrate_odometry;
   options.problem.max_preintegration_seconds = FLAGS_max_preintegration_seconds;
   SolverOptions& s = options.solver;

@@ -54,14 +54,14 @@ std::unique_ptr<FeatureTrajectory> FeatureTrajectory::Create(
     s.heading_map =
         CreateFeatureMap(*model->heading_kernel_, map_options, error);
     if (!s.heading_map) return nullptr;
-    model->weights_.push_back(
-        Eigen::VectorXd::Zero(s.position_map->num_features()));
-    model->weights_.push_back(
-        Eigen::VectorXd::Zero(s.position_map->num_features()));
-    model->weights_.push_back(
-        Eigen::VectorXd::Zero(s.heading_map->num_features()));
+    for (const int size :
+         {s.position_map->num_features(), s.position_map->num_features(),
+          s.heading_map->num_features()}) {
+      model->offsets_.push_back(model->offsets_.back() + size);
+    }
     model->segments_.push_back(std::move(s));
   }
+  model->weights_ = Eigen::VectorXd::Zero(model->offsets_.back());
   return model;
 }
 

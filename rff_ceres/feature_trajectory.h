@@ -52,11 +52,15 @@ class FeatureTrajectory : public TrajectoryModel {
       std::shared_ptr<const MeanFunction> mean, double t_begin, double t_end,
       std::string* error);
 
-  int num_blocks() const override { return static_cast<int>(weights_.size()); }
-  int block_size(int block) const override {
-    return static_cast<int>(weights_[block].size());
+  int num_blocks() const override {
+    return static_cast<int>(offsets_.size()) - 1;
   }
-  double* mutable_block(int block) override { return weights_[block].data(); }
+  int block_size(int block) const override {
+    return offsets_[block + 1] - offsets_[block];
+  }
+  double* mutable_block(int block) override {
+    return weights_.data() + offsets_[block];
+  }
   int num_segments() const { return static_cast<int>(segments_.size()); }
   PoseMap PoseAt(double t) const override;
   void AddPriorCosts(ceres::Problem* problem) override;
@@ -88,7 +92,11 @@ class FeatureTrajectory : public TrajectoryModel {
   std::vector<Segment> segments_;
   double overlap_ = 0.0;
   double origin_ = 0.0;
-  std::vector<Eigen::VectorXd> weights_;
+  // All blocks in one buffer, block b at offsets_[b]: Ceres orders the blocks
+  // of an elimination group by address, so contiguous storage in block order
+  // makes the solve's arithmetic (and its output) reproducible.
+  Eigen::VectorXd weights_;
+  std::vector<int> offsets_ = {0};
   // Observations at the same time share their feature vectors.
   mutable std::map<double, std::vector<Features>> cache_;
 };

@@ -88,8 +88,10 @@ bool Multilaterate(const std::vector<Eigen::Vector3d>& poses,
 
 bool InitializeLandmarks(const Dataset& dataset, const PoseFunction& pose,
                          std::map<LandmarkId, Eigen::Vector2d>* landmarks,
-                         std::string* error) {
+                         std::string* error,
+                         std::vector<LandmarkId>* unlocated) {
   landmarks->clear();
+  if (unlocated != nullptr) unlocated->clear();
   for (const LandmarkPrior& p : dataset.landmark_priors) {
     (*landmarks)[p.id] = Eigen::Vector2d(p.x, p.y);
   }
@@ -130,6 +132,10 @@ bool InitializeLandmarks(const Dataset& dataset, const PoseFunction& pose,
       l /= static_cast<double>(s.rb_poses.size());
     } else if (!Triangulate(s.bearing_poses, s.bearings, &l) &&
                !Multilaterate(s.range_poses, s.ranges, &l)) {
+      if (unlocated != nullptr) {
+        unlocated->push_back(id);
+        continue;
+      }
       *error = "landmark " + std::to_string(id) +
                " has no PRIOR_LANDMARK and its " +
                std::to_string(s.bearings.size()) + " bearing(s) and " +

@@ -9,6 +9,7 @@
 #include <functional>
 #include <map>
 #include <string>
+#include <vector>
 
 #include "Eigen/Core"
 #include "rff_ceres/types.h"
@@ -21,10 +22,12 @@ using PoseFunction = std::function<Eigen::Vector3d(double t)>;
 // Fills `landmarks` with one initial position per landmark that has a prior
 // or an observation. Fails, naming the landmark, when a landmark without a
 // prior cannot be located from its observations (e.g. one range only, or
-// bearings from a single direction).
+// bearings from a single direction). With `unlocated` non-null such
+// landmarks are listed there instead (incremental mode waits for more data).
 bool InitializeLandmarks(const Dataset& dataset, const PoseFunction& pose,
                          std::map<LandmarkId, Eigen::Vector2d>* landmarks,
-                         std::string* error);
+                         std::string* error,
+                         std::vector<LandmarkId>* unlocated = nullptr);
 
 }  // namespace rff
 

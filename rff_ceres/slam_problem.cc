@@ -1,14 +1,18 @@
 #include "rff_ceres/slam_problem.h"
 
 #include <algorithm>
+#include <cmath>
 
+#include "Eigen/Eigenvalues"
 #include "costs/bearing_cost.h"
+#include "costs/calibrated_range_cost.h"
+#include "costs/diagonal_prior_cost.h"
 #include "costs/landmark_prior_cost.h"
 #include "costs/odometry_cost.h"
 #include "costs/pose_prior_cost.h"
 #include "costs/range_bearing_cost.h"
 #include "costs/range_cost.h"
-#include "rff_ceres/odometry_preintegration.h"
+#include "rff_ceres/io/text_parser.h"
 
 namespace rff {
 
@@ -60,12 +64,17 @@ std::vector<double*> SlamProblem::LocalBlocks(std::vector<PoseMap*> maps,
 
 void SlamProblem::AddObservation(const Observation& o) {
   PoseMap map = model_->PoseAt(o.t);
-  double* landmark = landmarks_.at(o.id).data();
-  const std::vector<double*> blocks = LocalBlocks({&map}, landmark);
+  double* landmark = landmark_block(o.id);
+  std::vector<double*> blocks = LocalBlocks({&map}, landmark);
   ceres::CostFunction* cost = nullptr;
   switch (o.type) {
     case ObservationType::kRange:
-      cost = new RangeCost(std::move(map), o.range, o.sigma_range);
+      if (options_.range_calibration.estimate) {
+        blocks.push_back(range_calibration_.data());
+        cost = new CalibratedRangeCost(std::move(map), o.range, o.sigma_range);
+      } else {
+        cost = new RangeCost(std::move(map), o.range, o.sigma_range);
+      }
       break;
     case ObservationType::kBearing:
       cost = new BearingCost(std::move(map), o.bearing, o.sigma_bearing);
@@ -75,77 +84,240 @@ void SlamProblem::AddObservation(const Observation& o) {
                                   o.sigma_range, o.sigma_bearing);
       break;
   }
-  problem_->AddResidualBlock(cost, loss_.get(), blocks);
+  const char* kinds[] = {"range", "bearing", "range-bearing"};
+  Remember(problem_->AddResidualBlock(cost, loss_.get(), blocks),
+           {kinds[static_cast<int>(o.type)], o.t, o.t, o.id, true});
+}
+
+bool SlamProblem::Begin(const std::vector<LandmarkId>& landmark_ids,
+                        std::string* error) {
+  if (!CreateLoss(options_.loss, &loss_, error)) return false;
+  for (const LandmarkId id : landmark_ids) slots_.emplace(id, 0);
+  int slot = 0;
+  for (auto& [id, index] : slots_) index = slot++;
+  storage_.assign(slots_.size(), Eigen::Vector2d::Zero());
+  for (int b = 0; b < model_->num_blocks(); ++b) {
+    problem_->AddParameterBlock(model_->mutable_block(b),
+                                model_->block_size(b));
+  }
+  model_->AddPriorCosts(problem_.get());
+  const RangeCalibrationOptions& calibration = options_.range_calibration;
+  if (calibration.estimate) {
+    for (const double sigma :
+         {calibration.scale_sigma, calibration.offset_sigma}) {
+      if (!(sigma > 0.0) || !std::isfinite(sigma)) {
+        *error =
+            "range calibration prior sigmas must be finite and > 0, "
+            "got " +
+            FormatNumber(sigma);
+        return false;
+      }
+    }
+    problem_->AddResidualBlock(
+        new DiagonalPriorCost(
+            Eigen::Vector2d(1.0, 0.0),
+            Eigen::Vector2d(calibration.scale_sigma, calibration.offset_sigma)),
+        nullptr, range_calibration_.data());
+  }
+  return true;
+}
+
+void SlamProblem::AddLandmark(LandmarkId id, const Eigen::Vector2d& initial) {
+  Eigen::Vector2d& position = storage_[slots_.at(id)];
+  position = initial;
+  added_.insert(id);
+  problem_->AddParameterBlock(position.data(), 2);
+}
+
+std::map<LandmarkId, Eigen::Vector2d> SlamProblem::landmarks() const {
+  std::map<LandmarkId, Eigen::Vector2d> values;
+  for (const LandmarkId id : added_) values[id] = storage_[slots_.at(id)];
+  return values;
+}
+
+void SlamProblem::AddLandmarkPrior(const LandmarkPrior& p) {
+  Remember(problem_->AddResidualBlock(
+               new LandmarkPriorCost(Eigen::Vector2d(p.x, p.y), p.sigma),
+               nullptr, landmark_block(p.id)),
+           {"landmark prior", 0.0, 0.0, p.id, true});
+}
+
+void SlamProblem::AddPosePrior(const PosePrior& p) {
+  PoseMap map = model_->PoseAt(p.pose.t);
+  const std::vector<double*> blocks = LocalBlocks({&map}, nullptr);
+  Remember(
+      problem_->AddResidualBlock(
+          new PosePriorCost(
+              std::move(map), Eigen::Vector3d(p.pose.x, p.pose.y, p.pose.theta),
+              Eigen::Vector3d(p.sigma_xy, p.sigma_xy, p.sigma_theta)),
+          nullptr, blocks),
+      {"pose prior", p.pose.t, p.pose.t});
+}
+
+void SlamProblem::AddOdometry(const PreintegratedOdometry& o) {
+  PoseMap map0 = model_->PoseAt(o.t0);
+  PoseMap map1 = model_->PoseAt(o.t1);
+  const std::vector<double*> blocks = LocalBlocks({&map0, &map1}, nullptr);
+  Remember(problem_->AddResidualBlock(
+               new OdometryCost(std::move(map0), std::move(map1), o.motion,
+                                SqrtInformation(o.covariance)),
+               nullptr, blocks),
+           {"odometry", o.t0, o.t1});
+}
+
+std::vector<PreintegratedOdometry> SlamProblem::OdometryResiduals(
+    const Dataset& dataset) const {
+  if (!options_.use_odometry) return {};
+  // Chains end at every time a pose is needed; without preintegration,
+  // at every record (each record is a chain of its own).
+  std::vector<double> keep_times;
+  for (const Observation& o : dataset.observations) keep_times.push_back(o.t);
+  for (const PosePrior& p : dataset.pose_priors) keep_times.push_back(p.pose.t);
+  if (!options_.preintegrate_odometry) {
+    for (const Odometry& o : dataset.odometry) keep_times.push_back(o.t0);
+  }
+  std::sort(keep_times.begin(), keep_times.end());
+  return PreintegrateOdometry(dataset.odometry, keep_times,
+                              options_.max_preintegration_seconds);
 }
 
 bool SlamProblem::Build(const Dataset& dataset,
                         const std::map<LandmarkId, Eigen::Vector2d>& landmarks,
                         std::string* error) {
-  if (!CreateLoss(options_.loss, &loss_, error)) return false;
-  landmarks_ = landmarks;
   for (const Observation& o : dataset.observations) {
-    if (landmarks_.count(o.id) == 0) {
+    if (landmarks.count(o.id) == 0) {
       *error = "landmark " + std::to_string(o.id) +
                " is observed but has no initial position";
       return false;
     }
   }
-  for (int b = 0; b < model_->num_blocks(); ++b) {
-    problem_->AddParameterBlock(model_->mutable_block(b),
-                                model_->block_size(b));
-  }
-  for (auto& [id, position] : landmarks_) {
-    problem_->AddParameterBlock(position.data(), 2);
-  }
-  model_->AddPriorCosts(problem_.get());
-  for (const PosePrior& p : dataset.pose_priors) {
-    PoseMap map = model_->PoseAt(p.pose.t);
-    const std::vector<double*> blocks = LocalBlocks({&map}, nullptr);
-    problem_->AddResidualBlock(
-        new PosePriorCost(
-            std::move(map), Eigen::Vector3d(p.pose.x, p.pose.y, p.pose.theta),
-            Eigen::Vector3d(p.sigma_xy, p.sigma_xy, p.sigma_theta)),
-        nullptr, blocks);
-  }
-  for (const LandmarkPrior& p : dataset.landmark_priors) {
-    problem_->AddResidualBlock(
-        new LandmarkPriorCost(Eigen::Vector2d(p.x, p.y), p.sigma), nullptr,
-        landmarks_.at(p.id).data());
-  }
-  if (options_.use_odometry) {
-    // Chains end at every time a pose is needed; without preintegration,
-    // at every record (each record is a chain of its own).
-    std::vector<double> keep_times;
-    for (const Observation& o : dataset.observations) keep_times.push_back(o.t);
-    for (const PosePrior& p : dataset.pose_priors)
-      keep_times.push_back(p.pose.t);
-    if (!options_.preintegrate_odometry) {
-      for (const Odometry& o : dataset.odometry) keep_times.push_back(o.t0);
-    }
-    std::sort(keep_times.begin(), keep_times.end());
-    for (const PreintegratedOdometry& o :
-         PreintegrateOdometry(dataset.odometry, keep_times,
-                              options_.max_preintegration_seconds)) {
-      PoseMap map0 = model_->PoseAt(o.t0);
-      PoseMap map1 = model_->PoseAt(o.t1);
-      const std::vector<double*> blocks = LocalBlocks({&map0, &map1}, nullptr);
-      problem_->AddResidualBlock(
-          new OdometryCost(std::move(map0), std::move(map1), o.motion,
-                           SqrtInformation(o.covariance)),
-          nullptr, blocks);
-    }
+  std::vector<LandmarkId> ids;
+  for (const auto& [id, position] : landmarks) ids.push_back(id);
+  if (!Begin(ids, error)) return false;
+  for (const auto& [id, position] : landmarks) AddLandmark(id, position);
+  for (const PosePrior& p : dataset.pose_priors) AddPosePrior(p);
+  for (const LandmarkPrior& p : dataset.landmark_priors) AddLandmarkPrior(p);
+  for (const PreintegratedOdometry& o : OdometryResiduals(dataset)) {
+    AddOdometry(o);
   }
   for (const Observation& o : dataset.observations) AddObservation(o);
   return true;
 }
 
+std::string SlamProblem::Describe(ceres::ResidualBlockId id) const {
+  auto it = sources_.find(id);
+  if (it == sources_.end()) return "a trajectory prior residual";
+  const Source& s = it->second;
+  std::string text = std::string("the ") + s.kind + " residual";
+  if (s.t1 != s.t0) {
+    text += " from t = " + FormatNumber(s.t0) + " to " + FormatNumber(s.t1);
+  } else if (std::string(s.kind) != "landmark prior") {
+    text += " at t = " + FormatNumber(s.t0);
+  }
+  if (s.has_landmark) text += " of landmark " + std::to_string(s.landmark);
+  return text;
+}
+
+bool SlamProblem::FindNonFinite(std::string* description) {
+  std::vector<ceres::ResidualBlockId> ids;
+  problem_->GetResidualBlocks(&ids);
+  std::vector<double> residuals;
+  std::vector<std::vector<double>> jacobians;
+  std::vector<double*> jacobian_pointers;
+  for (const ceres::ResidualBlockId id : ids) {
+    const ceres::CostFunction* cost =
+        problem_->GetCostFunctionForResidualBlock(id);
+    const std::vector<int32_t>& sizes = cost->parameter_block_sizes();
+    residuals.assign(cost->num_residuals(), 0.0);
+    jacobians.resize(sizes.size());
+    jacobian_pointers.resize(sizes.size());
+    for (std::size_t i = 0; i < sizes.size(); ++i) {
+      jacobians[i].assign(cost->num_residuals() * sizes[i], 0.0);
+      jacobian_pointers[i] = jacobians[i].data();
+    }
+    double cost_value = 0.0;
+    const bool ok = problem_->EvaluateResidualBlock(
+        id, /*apply_loss_function=*/true, &cost_value, residuals.data(),
+        jacobian_pointers.data());
+    bool finite = ok && std::isfinite(cost_value);
+    for (const double r : residuals) finite = finite && std::isfinite(r);
+    for (const std::vector<double>& j : jacobians) {
+      for (const double v : j) finite = finite && std::isfinite(v);
+    }
+    if (!finite) {
+      *description = Describe(id) + " is not finite";
+      return true;
+    }
+  }
+  return false;
+}
+
+bool SlamProblem::CheckLandmarksDetermined(double max_condition,
+                                           std::string* error) {
+  std::vector<double> residuals;
+  std::vector<std::vector<double>> jacobians;
+  std::vector<double*> jacobian_pointers;
+  for (const LandmarkId id : added_) {
+    const double* position = landmark_block(id);
+    // Information of the landmark given the trajectory: sum of J_l^T J_l.
+    Eigen::Matrix2d information = Eigen::Matrix2d::Zero();
+    for (const ceres::ResidualBlockId block : landmark_residuals_[id]) {
+      std::vector<double*> parameters;
+      problem_->GetParameterBlocksForResidualBlock(block, &parameters);
+      const ceres::CostFunction* cost =
+          problem_->GetCostFunctionForResidualBlock(block);
+      const int n = cost->num_residuals();
+      residuals.assign(n, 0.0);
+      jacobians.assign(parameters.size(), {});
+      jacobian_pointers.assign(parameters.size(), nullptr);
+      int landmark_index = -1;
+      for (std::size_t i = 0; i < parameters.size(); ++i) {
+        if (parameters[i] != position) continue;
+        landmark_index = static_cast<int>(i);
+        jacobians[i].assign(n * 2, 0.0);
+        jacobian_pointers[i] = jacobians[i].data();
+      }
+      double cost_value = 0.0;
+      if (landmark_index < 0 ||
+          !problem_->EvaluateResidualBlock(block,
+                                           /*apply_loss_function=*/false,
+                                           &cost_value, residuals.data(),
+                                           jacobian_pointers.data())) {
+        continue;
+      }
+      const Eigen::Map<
+          const Eigen::Matrix<double, Eigen::Dynamic, 2, Eigen::RowMajor>>
+          j(jacobians[landmark_index].data(), n, 2);
+      information += j.transpose() * j;
+    }
+    const Eigen::Vector2d eigenvalues =
+        Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(information)
+            .eigenvalues();
+    if (!eigenvalues.allFinite() || !(eigenvalues[0] > 0.0) ||
+        eigenvalues[1] > max_condition * eigenvalues[0]) {
+      *error = "landmark " + std::to_string(id) +
+               " is not determined by its measurements (information "
+               "eigenvalues " +
+               FormatNumber(eigenvalues[0]) + " and " +
+               FormatNumber(eigenvalues[1]) +
+               "): give it a PRIOR_LANDMARK or observe it from more places";
+      return false;
+    }
+  }
+  return true;
+}
+
 std::shared_ptr<ceres::ParameterBlockOrdering> SlamProblem::Ordering() {
   auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
-  for (auto& [id, position] : landmarks_) {
-    ordering->AddElementToGroup(position.data(), 0);
+  for (const LandmarkId id : added_) {
+    ordering->AddElementToGroup(landmark_block(id), 0);
   }
   for (int b = 0; b < model_->num_blocks(); ++b) {
     ordering->AddElementToGroup(model_->mutable_block(b), 1);
+  }
+  // A group of its own, so its place does not depend on its address.
+  if (options_.range_calibration.estimate) {
+    ordering->AddElementToGroup(range_calibration_.data(), 2);
   }
   return ordering;
 }

@@ -8,6 +8,7 @@
 
 #include <map>
 #include <memory>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -15,6 +16,7 @@
 #include "ceres/loss_function.h"
 #include "ceres/ordered_groups.h"
 #include "ceres/problem.h"
+#include "rff_ceres/odometry_preintegration.h"
 #include "rff_ceres/trajectory_model.h"
 #include "rff_ceres/types.h"
 
@@ -32,8 +34,18 @@ struct LossOptions {
 bool CreateLoss(const LossOptions& options,
                 std::unique_ptr<ceres::LossFunction>* loss, std::string* error);
 
+// Self-calibration of the range sensor: every RANGE record is modelled as
+// scale * distance + offset with one (scale, offset) for the whole run, under
+// the prior scale ~ N(1, scale_sigma^2), offset ~ N(0, offset_sigma^2).
+struct RangeCalibrationOptions {
+  bool estimate = false;
+  double scale_sigma = 0.1;
+  double offset_sigma = 1.0;  // m
+};
+
 struct ProblemOptions {
   LossOptions loss;
+  RangeCalibrationOptions range_calibration;
   bool use_odometry = true;
   // Compose ODOM chains between observation times into one residual each
   // (see odometry_preintegration.h).
@@ -52,11 +64,49 @@ class SlamProblem {
              const std::map<LandmarkId, Eigen::Vector2d>& landmarks,
              std::string* error);
 
+  // The same problem built piece by piece (incremental mode): Begin() adds
+  // the trajectory blocks and their prior and makes room for the landmarks
+  // with the given ids, then residuals are added as the data arrives. A
+  // landmark must be added before its prior or observations.
+  bool Begin(const std::vector<LandmarkId>& landmark_ids, std::string* error);
+  void AddLandmark(LandmarkId id, const Eigen::Vector2d& initial);
+  bool has_landmark(LandmarkId id) const { return added_.count(id) > 0; }
+  void AddLandmarkPrior(const LandmarkPrior& prior);
+  void AddPosePrior(const PosePrior& prior);
+  void AddOdometry(const PreintegratedOdometry& odometry);
+  void AddObservation(const Observation& observation);
+  // The odometry residuals of `dataset` under the options (composed chains
+  // ending at every observation and prior time, or one per record).
+  std::vector<PreintegratedOdometry> OdometryResiduals(
+      const Dataset& dataset) const;
+
   ceres::Problem* problem() { return problem_.get(); }
-  const std::map<LandmarkId, Eigen::Vector2d>& landmarks() const {
-    return landmarks_;
+  // (scale, offset) of the range sensor: (1, 0) unless estimated. Set it
+  // before Begin() to start from another value.
+  const Eigen::Vector2d& range_calibration() const {
+    return range_calibration_;
   }
-  // Landmarks in group 0 (eliminated first), trajectory blocks in group 1.
+  void set_range_calibration(const Eigen::Vector2d& value) {
+    range_calibration_ = value;
+  }
+
+  // The current values of the added landmarks.
+  std::map<LandmarkId, Eigen::Vector2d> landmarks() const;
+  // The parameter block of a landmark (nullptr if the problem has none).
+  double* landmark_block(LandmarkId id) {
+    return has_landmark(id) ? storage_[slots_.at(id)].data() : nullptr;
+  }
+  // Numerical guards. FindNonFinite evaluates every residual block at the
+  // current values and describes the first whose residual or Jacobian is
+  // not finite (false if there is none). CheckLandmarksDetermined fails,
+  // naming the landmark, when a landmark's information from its own
+  // residuals (without robust weights) is singular or ill-conditioned
+  // (condition number above `max_condition`): its estimate would be noise.
+  bool FindNonFinite(std::string* description);
+  bool CheckLandmarksDetermined(double max_condition, std::string* error);
+
+  // Landmarks in group 0 (eliminated first), trajectory blocks in group 1,
+  // the range calibration in group 2.
   std::shared_ptr<ceres::ParameterBlockOrdering> Ordering();
 
  private:
@@ -64,13 +114,33 @@ class SlamProblem {
   // cost's local indices, in place), with `landmark` appended if non-null.
   std::vector<double*> LocalBlocks(std::vector<PoseMap*> maps,
                                    double* landmark);
-  void AddObservation(const Observation& observation);
+
+  // What a residual block is, for messages.
+  struct Source {
+    const char* kind = "";
+    double t0 = 0.0, t1 = 0.0;
+    LandmarkId landmark = 0;
+    bool has_landmark = false;
+  };
+  std::string Describe(ceres::ResidualBlockId id) const;
+  void Remember(ceres::ResidualBlockId id, const Source& source) {
+    sources_[id] = source;
+    if (source.has_landmark) landmark_residuals_[source.landmark].push_back(id);
+  }
 
   TrajectoryModel* model_;
   ProblemOptions options_;
+  std::map<ceres::ResidualBlockId, Source> sources_;
+  // Ceres's own lookup scans every residual (without fast removal).
+  std::map<LandmarkId, std::vector<ceres::ResidualBlockId>> landmark_residuals_;
   std::unique_ptr<ceres::LossFunction> loss_;
   std::unique_ptr<ceres::Problem> problem_;
-  std::map<LandmarkId, Eigen::Vector2d> landmarks_;
+  // Landmark blocks in one buffer in id order (Ceres orders an elimination
+  // group by address: this keeps the solve's arithmetic reproducible).
+  std::map<LandmarkId, int> slots_;
+  std::vector<Eigen::Vector2d> storage_;
+  std::set<LandmarkId> added_;
+  Eigen::Vector2d range_calibration_ = Eigen::Vector2d(1.0, 0.0);
 };
 
 }  // namespace rff

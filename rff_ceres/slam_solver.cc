@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <fstream>
+#include <limits>
 
 #include "ceres/types.h"
 #include "glog/logging.h"
@@ -11,6 +12,7 @@
 #include "rff_ceres/landmark_init.h"
 #include "rff_ceres/mean/prior_mean.h"
 #include "rff_ceres/mean/spline_mean.h"
+#include "rff_ceres/posterior_covariance.h"
 
 namespace rff {
 namespace {
@@ -132,6 +134,273 @@ std::vector<double> OutputTimes(const Dataset& dataset) {
   return times;
 }
 
+std::unique_ptr<TrajectoryModel> CreateTrajectoryModel(
+    const Dataset& dataset, const SlamOptions& options,
+    std::shared_ptr<const MeanFunction> mean, std::string* error) {
+  double t_begin, t_end;
+  TimeSpan(dataset, &t_begin, &t_end);
+  if (options.prior == "rff") {
+    return FeatureTrajectory::Create(options.trajectory, std::move(mean),
+                                     t_begin, t_end, error);
+  }
+  if (options.prior == "wnoa") {
+    // A state at every distinct observation time, and at both ends of the
+    // run so that no query extrapolates.
+    std::vector<double> times = {t_begin, t_end};
+    for (const Observation& o : dataset.observations) times.push_back(o.t);
+    return WnoaTrajectory::Create(options.wnoa, std::move(mean),
+                                  std::move(times), error);
+  }
+  *error = "unknown prior '" + options.prior + "' (expected rff or wnoa)";
+  return nullptr;
+}
+
+namespace {
+
+// Schur solvers eliminate the landmarks first. The others get no ordering:
+// their fill-reducing ordering (AMD) puts landmarks seen from the whole run
+// last, where eliminating them first would make the system dense (the WNOA
+// states of Plaza: 3500 states, 4 landmarks).
+void SetOrdering(SlamProblem* problem, ceres::Solver::Options* options) {
+  const ceres::LinearSolverType type = options->linear_solver_type;
+  if (type == ceres::DENSE_SCHUR || type == ceres::SPARSE_SCHUR ||
+      type == ceres::ITERATIVE_SCHUR) {
+    options->linear_solver_ordering = problem->Ordering();
+  } else {
+    options->linear_solver_ordering.reset();
+  }
+}
+
+// A solve is accepted only if Ceres did not fail and the cost is finite.
+// On failure the first non-finite residual is named, when there is one.
+bool CheckSolve(const ceres::Solver::Summary& summary, SlamProblem* problem,
+                std::string* error) {
+  if (summary.termination_type != ceres::FAILURE &&
+      summary.termination_type != ceres::USER_FAILURE &&
+      std::isfinite(summary.final_cost)) {
+    return true;
+  }
+  std::string culprit;
+  *error = "the solve failed: " + summary.message;
+  if (problem->FindNonFinite(&culprit)) *error += " (" + culprit + ")";
+  return false;
+}
+
+// Largest |coordinate| of the poses and landmarks, for the runaway check.
+double Extent(const std::vector<TimedPose>& poses,
+              const std::map<LandmarkId, Eigen::Vector2d>& landmarks) {
+  double extent = 0.0;
+  for (const TimedPose& p : poses) {
+    extent = std::max({extent, std::abs(p.x), std::abs(p.y)});
+  }
+  for (const auto& [id, l] : landmarks) extent = std::max(extent, l.norm());
+  return extent;
+}
+
+// The trajectory at the output times, with the divergence guards: every
+// value finite, and nothing run away to more than 1000 times the scale of
+// the initial scene (which a converged solution never does).
+bool CollectTrajectory(const Dataset& dataset, const TrajectoryModel& model,
+                       const std::map<LandmarkId, Eigen::Vector2d>& landmarks,
+                       double initial_extent, SlamResult* result,
+                       std::string* error) {
+  result->trajectory.clear();
+  for (const double t : OutputTimes(dataset)) {
+    const Eigen::Vector3d pose = model.Pose(t);
+    if (!pose.allFinite()) {
+      *error = "the solve diverged: non-finite pose at t = " + FormatNumber(t);
+      return false;
+    }
+    result->trajectory.push_back({t, pose.x(), pose.y(), WrapAngle(pose.z())});
+  }
+  for (const auto& [id, position] : landmarks) {
+    if (!position.allFinite()) {
+      *error = "the solve diverged: non-finite landmark " + std::to_string(id);
+      return false;
+    }
+  }
+  const double limit = 1000.0 * (initial_extent + 1.0);
+  const double extent = Extent(result->trajectory, landmarks);
+  if (extent > limit) {
+    *error = "the solve diverged: the estimate reaches " +
+             FormatNumber(extent) + " m from the origin, the initial scene " +
+             FormatNumber(initial_extent) + " m";
+    return false;
+  }
+  return true;
+}
+
+// Paper III-B.2: after each solve the prior mean becomes a smoothing spline
+// of the estimate and the weights restart from zero.
+bool SolveBatch(const Dataset& dataset, const SlamOptions& options,
+                ceres::Solver::Options ceres_options, TrajectoryModel* model,
+                std::map<LandmarkId, Eigen::Vector2d>* landmarks,
+                double initial_extent, std::unique_ptr<SlamProblem>* problem,
+                SlamResult* result, std::string* error) {
+  for (int round = 0;; ++round) {
+    *problem = std::make_unique<SlamProblem>(model, options.problem);
+    (*problem)->set_range_calibration(result->range_calibration);
+    if (!(*problem)->Build(dataset, *landmarks, error)) return false;
+    SetOrdering(problem->get(), &ceres_options);
+    ceres::Solve(ceres_options, (*problem)->problem(), &result->summary);
+    VLOG(1) << result->summary.FullReport();
+    if (!CheckSolve(result->summary, problem->get(), error)) return false;
+    result->converged = result->summary.termination_type == ceres::CONVERGENCE;
+    result->total_iterations +=
+        static_cast<int>(result->summary.iterations.size());
+    *landmarks = (*problem)->landmarks();
+    result->range_calibration = (*problem)->range_calibration();
+    if (!CollectTrajectory(dataset, *model, *landmarks, initial_extent, result,
+                           error)) {
+      return false;
+    }
+    if (round >= options.outer_rounds) return true;
+    std::shared_ptr<const MeanFunction> mean =
+        RefitSplineMean(result->trajectory,
+                        DataFitWeights(dataset, result->trajectory, *landmarks),
+                        options.spline_smoothing, error);
+    if (!mean) return false;
+    model->set_mean(mean);
+    for (int b = 0; b < model->num_blocks(); ++b) {
+      Eigen::Map<Eigen::VectorXd>(model->mutable_block(b), model->block_size(b))
+          .setZero();
+    }
+  }
+}
+
+// The paper's online protocol: measurements in time order, a warm-started
+// re-solve after every K of them. Trajectory blocks enter the problem (become
+// variable) when a residual first touches them and are frozen once no
+// residual has touched them for `lag` seconds; landmarks enter when their
+// observations so far locate them.
+bool SolveIncremental(const Dataset& dataset, const SlamOptions& options,
+                      ceres::Solver::Options ceres_options,
+                      TrajectoryModel* model,
+                      std::map<LandmarkId, Eigen::Vector2d>* landmarks,
+                      std::unique_ptr<SlamProblem>* problem, SlamResult* result,
+                      std::string* error) {
+  const IncrementalOptions& incremental = options.incremental;
+  *problem = std::make_unique<SlamProblem>(model, options.problem);
+  SlamProblem& slam = **problem;
+  std::vector<LandmarkId> ids;
+  for (const LandmarkPrior& p : dataset.landmark_priors) ids.push_back(p.id);
+  for (const Observation& o : dataset.observations) ids.push_back(o.id);
+  if (!slam.Begin(ids, error)) return false;
+  ceres::Problem* ceres_problem = slam.problem();
+
+  // Newest time each trajectory block has been touched at (-inf: never).
+  std::vector<double> touched(model->num_blocks(),
+                              -std::numeric_limits<double>::infinity());
+  auto touch = [&](double t) {
+    for (const PoseTerm& term : model->PoseAt(t).terms) {
+      touched[term.block] = std::max(touched[term.block], t);
+    }
+  };
+  for (const LandmarkPrior& p : dataset.landmark_priors) {
+    slam.AddLandmark(p.id, Eigen::Vector2d(p.x, p.y));
+    slam.AddLandmarkPrior(p);
+  }
+  const std::vector<PreintegratedOdometry> odometry =
+      slam.OdometryResiduals(dataset);
+  std::size_t next_odometry = 0, next_prior = 0;
+  std::vector<Observation> pending;  // Of landmarks not located yet.
+
+  const std::vector<Observation>& observations = dataset.observations;
+  for (std::size_t i = 0; i < observations.size(); ++i) {
+    const Observation& o = observations[i];
+    touch(o.t);
+    if (slam.has_landmark(o.id)) {
+      slam.AddObservation(o);
+    } else {
+      pending.push_back(o);
+    }
+    const bool last = i + 1 == observations.size();
+    if ((i + 1) % incremental.every != 0 && !last) continue;
+
+    const auto start = std::chrono::steady_clock::now();
+    const double now = o.t;
+    for (; next_prior < dataset.pose_priors.size() &&
+           dataset.pose_priors[next_prior].pose.t <= now;
+         ++next_prior) {
+      slam.AddPosePrior(dataset.pose_priors[next_prior]);
+      touch(dataset.pose_priors[next_prior].pose.t);
+    }
+    for (; next_odometry < odometry.size() && odometry[next_odometry].t1 <= now;
+         ++next_odometry) {
+      slam.AddOdometry(odometry[next_odometry]);
+      touch(odometry[next_odometry].t0);
+      touch(odometry[next_odometry].t1);
+    }
+    if (!pending.empty()) {
+      Dataset seen;
+      seen.observations = pending;
+      std::map<LandmarkId, Eigen::Vector2d> located;
+      std::vector<LandmarkId> unlocated;
+      InitializeLandmarks(
+          seen, [&](double t) { return model->Pose(t); }, &located, error,
+          &unlocated);
+      std::vector<Observation> still_pending;
+      for (const auto& [id, position] : located) slam.AddLandmark(id, position);
+      for (const Observation& p : pending) {
+        if (slam.has_landmark(p.id)) {
+          slam.AddObservation(p);
+        } else {
+          still_pending.push_back(p);
+        }
+      }
+      pending.swap(still_pending);
+    }
+
+    IncrementalUpdate update;
+    update.t = now;
+    update.num_measurements = static_cast<int>(i + 1);
+    for (int b = 0; b < model->num_blocks(); ++b) {
+      const bool active =
+          touched[b] > -std::numeric_limits<double>::infinity() &&
+          (incremental.lag <= 0.0 || touched[b] >= now - incremental.lag);
+      if (active) {
+        ceres_problem->SetParameterBlockVariable(model->mutable_block(b));
+        ++update.active_blocks;
+      } else {
+        ceres_problem->SetParameterBlockConstant(model->mutable_block(b));
+      }
+    }
+    // The preprocessor edits the ordering it is given: a fresh one per solve.
+    SetOrdering(&slam, &ceres_options);
+    ceres::Solve(ceres_options, ceres_problem, &result->summary);
+    if (!CheckSolve(result->summary, &slam, error)) {
+      *error = "update at t = " + FormatNumber(now) + ": " + *error;
+      return false;
+    }
+    update.iterations = static_cast<int>(result->summary.iterations.size());
+    result->total_iterations += update.iterations;
+    update.seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
+            .count();
+    result->updates.push_back(update);
+    VLOG(1) << "update at t = " << now << ": " << update.num_measurements
+            << " measurements, " << update.active_blocks << " active blocks, "
+            << update.iterations << " iterations, " << update.seconds << " s";
+  }
+  if (!pending.empty()) {
+    *error = "landmark " + std::to_string(pending.front().id) +
+             " has no PRIOR_LANDMARK and its observations do not locate it";
+    return false;
+  }
+  // Everything the data touched is a variable again, for the covariance.
+  for (int b = 0; b < model->num_blocks(); ++b) {
+    if (touched[b] > -std::numeric_limits<double>::infinity()) {
+      ceres_problem->SetParameterBlockVariable(model->mutable_block(b));
+    }
+  }
+  result->converged = result->summary.termination_type == ceres::CONVERGENCE;
+  *landmarks = slam.landmarks();
+  result->range_calibration = slam.range_calibration();
+  return true;
+}
+
+}  // namespace
+
 bool RunSlam(const Dataset& dataset, const SlamOptions& options,
              SlamResult* result, std::string* error) {
   const auto start = std::chrono::steady_clock::now();
@@ -148,73 +417,77 @@ bool RunSlam(const Dataset& dataset, const SlamOptions& options,
              FormatNumber(options.spline_smoothing);
     return false;
   }
+  const IncrementalOptions& incremental = options.incremental;
+  if (incremental.every < 0) {
+    *error = "incremental_every must be >= 0, got " +
+             std::to_string(incremental.every);
+    return false;
+  }
+  if (!(incremental.lag >= 0.0) || !std::isfinite(incremental.lag)) {
+    *error = "incremental_lag must be finite and >= 0, got " +
+             FormatNumber(incremental.lag);
+    return false;
+  }
+  if (incremental.every > 0 && options.outer_rounds > 0) {
+    *error =
+        "outer_rounds (spline refits of the whole run) cannot be "
+        "combined with the incremental mode";
+    return false;
+  }
+  if (dataset.observations.empty() && dataset.odometry.empty()) {
+    *error =
+        "the dataset has no observations and no odometry: nothing to "
+        "estimate";
+    return false;
+  }
 
   std::shared_ptr<const MeanFunction> mean =
       BuildPriorMean(options.prior_mean, dataset, error);
   if (!mean) return false;
-  double t_begin, t_end;
-  TimeSpan(dataset, &t_begin, &t_end);
-  std::unique_ptr<FeatureTrajectory> model = FeatureTrajectory::Create(
-      options.trajectory, mean, t_begin, t_end, error);
+  std::unique_ptr<TrajectoryModel> model =
+      CreateTrajectoryModel(dataset, options, mean, error);
   if (!model) return false;
 
+  // The initial scene: the prior mean, the landmarks' initial positions and
+  // the longest range, to tell a run-away solution from a large scene.
   std::map<LandmarkId, Eigen::Vector2d> landmarks;
-  if (!InitializeLandmarks(
+  if (incremental.every == 0 &&
+      !InitializeLandmarks(
           dataset, [&](double t) { return mean->Evaluate(t); }, &landmarks,
           error)) {
     return false;
   }
+  std::vector<TimedPose> initial;
+  for (const double t : OutputTimes(dataset)) {
+    const Eigen::Vector3d pose = model->Pose(t);
+    initial.push_back({t, pose.x(), pose.y(), pose.z()});
+  }
+  double initial_extent = Extent(initial, landmarks);
+  for (const LandmarkPrior& p : dataset.landmark_priors) {
+    initial_extent = std::max(initial_extent, std::hypot(p.x, p.y));
+  }
+  double longest_range = 0.0;
+  for (const Observation& o : dataset.observations) {
+    if (o.HasRange())
+      longest_range = std::max(longest_range, std::abs(o.range));
+  }
+  initial_extent += longest_range;
+
   ProgressLogger progress;
   if (options.solver.log_progress) ceres_options.callbacks.push_back(&progress);
-  // Paper III-B.2: after each solve the prior mean becomes a smoothing spline
-  // of the estimate and the weights restart from zero.
-  for (int round = 0;; ++round) {
-    SlamProblem problem(model.get(), options.problem);
-    if (!problem.Build(dataset, landmarks, error)) return false;
-    ceres_options.linear_solver_ordering = problem.Ordering();
-    ceres::Solve(ceres_options, problem.problem(), &result->summary);
-    VLOG(1) << result->summary.FullReport();
-    const ceres::Solver::Summary& summary = result->summary;
-    if (summary.termination_type == ceres::FAILURE ||
-        summary.termination_type == ceres::USER_FAILURE ||
-        !std::isfinite(summary.final_cost)) {
-      *error = "the solve failed: " + summary.message;
+  std::unique_ptr<SlamProblem> problem;
+  if (incremental.every > 0) {
+    if (!SolveIncremental(dataset, options, ceres_options, model.get(),
+                          &landmarks, &problem, result, error) ||
+        !CollectTrajectory(dataset, *model, landmarks, initial_extent, result,
+                           error)) {
       return false;
     }
-    result->converged = summary.termination_type == ceres::CONVERGENCE;
-    result->total_iterations += static_cast<int>(summary.iterations.size());
-    landmarks = problem.landmarks();
-
-    result->trajectory.clear();
-    for (const double t : OutputTimes(dataset)) {
-      const Eigen::Vector3d pose = model->Pose(t);
-      if (!pose.allFinite()) {
-        *error =
-            "the solve diverged: non-finite pose at t = " + FormatNumber(t);
-        return false;
-      }
-      result->trajectory.push_back(
-          {t, pose.x(), pose.y(), WrapAngle(pose.z())});
-    }
-    for (const auto& [id, position] : landmarks) {
-      if (!position.allFinite()) {
-        *error =
-            "the solve diverged: non-finite landmark " + std::to_string(id);
-        return false;
-      }
-    }
-    if (round >= options.outer_rounds) break;
-    mean =
-        RefitSplineMean(result->trajectory,
-                        DataFitWeights(dataset, result->trajectory, landmarks),
-                        options.spline_smoothing, error);
-    if (!mean) return false;
-    model->set_mean(mean);
-    for (int b = 0; b < model->num_blocks(); ++b) {
-      Eigen::Map<Eigen::VectorXd>(model->mutable_block(b), model->block_size(b))
-          .setZero();
-    }
+  } else if (!SolveBatch(dataset, options, ceres_options, model.get(),
+                         &landmarks, initial_extent, &problem, result, error)) {
+    return false;
   }
+  if (!problem->CheckLandmarksDetermined(1e12, error)) return false;
   for (const auto& [id, position] : landmarks) {
     Landmark l;
     l.id = id;
@@ -222,10 +495,75 @@ bool RunSlam(const Dataset& dataset, const SlamOptions& options,
     l.y = position.y();
     result->landmarks.push_back(l);
   }
+  if (options.compute_covariance) {
+    std::vector<double> times;
+    for (const TimedPose& p : result->trajectory) times.push_back(p.t);
+    CovarianceOptions covariance_options;
+    covariance_options.num_threads = options.solver.num_threads;
+    if (!ComputePosteriorCovariance(
+            problem.get(), *model, times, covariance_options,
+            &result->pose_covariances, &result->landmarks, error)) {
+      return false;
+    }
+  }
   result->solve_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
           .count();
   return true;
+}
+
+namespace {
+
+// Mean and max of the incremental update times.
+void UpdateTimes(const SlamResult& result, double* mean, double* max) {
+  *mean = 0.0;
+  *max = 0.0;
+  for (const IncrementalUpdate& u : result.updates) {
+    *mean += u.seconds;
+    *max = std::max(*max, u.seconds);
+  }
+  if (!result.updates.empty()) *mean /= result.updates.size();
+}
+
+}  // namespace
+
+void PrintSlamSummary(const SlamOptions& options, const SlamResult& result,
+                      std::ostream* out) {
+  const ceres::Solver::Summary& s = result.summary;
+  const FeatureTrajectoryOptions& t = options.trajectory;
+  if (options.prior == "wnoa") {
+    *out << "  model        WNOA (LTV-SDE) prior, Q_c = "
+         << options.wnoa.position_qc << " (x, y), " << options.wnoa.heading_qc
+         << " (theta), " << options.prior_mean << " mean\n";
+  } else {
+    *out << "  model        " << t.family << " features, "
+         << t.position_kernel.name << " kernel, D = " << t.num_position_features
+         << " (x, y), " << t.num_heading_features << " (theta), "
+         << options.prior_mean << " mean\n";
+  }
+  *out << "  problem      " << s.num_residual_blocks << " residual blocks, "
+       << s.num_parameters << " parameters\n"
+       << "  solver       " << options.solver.linear_solver << ", "
+       << result.total_iterations << " iterations, "
+       << ceres::TerminationTypeToString(s.termination_type) << "\n"
+       << "  cost         " << s.initial_cost << " -> " << s.final_cost << "\n"
+       << "  time         " << s.total_time_in_seconds << " s in Ceres, "
+       << result.solve_seconds << " s total\n";
+  if (options.problem.range_calibration.estimate) {
+    *out << "  range model  " << result.range_calibration[0] << " * distance + "
+         << result.range_calibration[1] << " m\n";
+  }
+  if (!result.updates.empty()) {
+    double mean, max;
+    UpdateTimes(result, &mean, &max);
+    *out << "  incremental  " << result.updates.size() << " updates (every "
+         << options.incremental.every << " measurements), " << mean * 1e3
+         << " ms mean, " << max * 1e3 << " ms max per update\n";
+  }
+  if (!result.converged) {
+    *out << "  warning: the solver stopped before convergence: " << s.message
+         << "\n";
+  }
 }
 
 bool WriteSummaryJson(const SlamOptions& options, const SlamResult& result,
@@ -234,7 +572,10 @@ bool WriteSummaryJson(const SlamOptions& options, const SlamResult& result,
   if (!OpenForWriting(path, &out, error)) return false;
   const ceres::Solver::Summary& s = result.summary;
   const FeatureTrajectoryOptions& t = options.trajectory;
+  double update_mean, update_max;
+  UpdateTimes(result, &update_mean, &update_max);
   out << "{\n"
+      << "  \"prior\": " << JsonString(options.prior) << ",\n"
       << "  \"prior_mean\": " << JsonString(options.prior_mean) << ",\n"
       << "  \"kernel\": " << JsonString(t.position_kernel.name) << ",\n"
       << "  \"heading_kernel\": " << JsonString(t.heading_kernel.name) << ",\n"
@@ -246,6 +587,10 @@ bool WriteSummaryJson(const SlamOptions& options, const SlamResult& result,
       << "  \"num_features\": " << t.num_position_features << ",\n"
       << "  \"num_heading_features\": " << t.num_heading_features << ",\n"
       << "  \"seed\": " << t.seed << ",\n"
+      << "  \"wnoa_position_qc\": " << FormatNumber(options.wnoa.position_qc)
+      << ",\n"
+      << "  \"wnoa_heading_qc\": " << FormatNumber(options.wnoa.heading_qc)
+      << ",\n"
       << "  \"loss\": " << JsonString(options.problem.loss.name) << ",\n"
       << "  \"linear_solver\": " << JsonString(options.solver.linear_solver)
       << ",\n"
@@ -262,7 +607,15 @@ bool WriteSummaryJson(const SlamOptions& options, const SlamResult& result,
       << ",\n"
       << "  \"total_seconds\": " << FormatNumber(result.solve_seconds) << ",\n"
       << "  \"num_poses\": " << result.trajectory.size() << ",\n"
-      << "  \"num_landmarks\": " << result.landmarks.size() << "\n"
+      << "  \"num_landmarks\": " << result.landmarks.size() << ",\n"
+      << "  \"range_scale\": " << FormatNumber(result.range_calibration[0])
+      << ",\n"
+      << "  \"range_offset\": " << FormatNumber(result.range_calibration[1])
+      << ",\n"
+      << "  \"incremental_every\": " << options.incremental.every << ",\n"
+      << "  \"incremental_updates\": " << result.updates.size() << ",\n"
+      << "  \"update_seconds_mean\": " << FormatNumber(update_mean) << ",\n"
+      << "  \"update_seconds_max\": " << FormatNumber(update_max) << "\n"
       << "}\n";
   return FinishWriting(path, &out, error);
 }

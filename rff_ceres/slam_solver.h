@@ -5,13 +5,17 @@
 #ifndef RFF_CERES_SLAM_SOLVER_H_
 #define RFF_CERES_SLAM_SOLVER_H_
 
+#include <memory>
+#include <ostream>
 #include <string>
 #include <vector>
 
+#include "Eigen/Core"
 #include "ceres/solver.h"
 #include "rff_ceres/feature_trajectory.h"
 #include "rff_ceres/slam_problem.h"
 #include "rff_ceres/types.h"
+#include "rff_ceres/wnoa_trajectory.h"
 
 namespace rff {
 
@@ -32,15 +36,42 @@ struct SolverOptions {
 bool ToCeresOptions(const SolverOptions& options,
                     ceres::Solver::Options* ceres_options, std::string* error);
 
+// Incremental mode (the paper's Plaza protocol): measurements are fed in time
+// order and the problem is re-solved, warm-started, after every `every` new
+// range/bearing measurements.
+struct IncrementalOptions {
+  int every = 0;  // K; 0: one batch solve.
+  // Trajectory blocks not touched by a measurement in the last `lag` seconds
+  // are frozen (held constant); 0: none is frozen.
+  double lag = 0.0;
+};
+
 struct SlamOptions {
+  // Trajectory prior: "rff" (weight-space features, FeatureTrajectory) or
+  // "wnoa" (LTV-SDE states, WnoaTrajectory).
+  std::string prior = "rff";
   std::string prior_mean = "auto";
   FeatureTrajectoryOptions trajectory;
+  WnoaOptions wnoa;
   ProblemOptions problem;
   SolverOptions solver;
   // Outer rounds of the paper's smoothing-spline prior (III-B.2): after each
   // solve, refit the mean to the estimate and solve again. 0: one solve.
   int outer_rounds = 0;
   double spline_smoothing = 0.98;  // De Boor's p.
+  // Posterior covariance of every output pose and landmark (see
+  // posterior_covariance.h).
+  bool compute_covariance = false;
+  IncrementalOptions incremental;
+};
+
+// One re-solve of the incremental mode.
+struct IncrementalUpdate {
+  double t = 0.0;            // Time of the newest measurement.
+  int num_measurements = 0;  // Range/bearing measurements so far.
+  int iterations = 0;
+  int active_blocks = 0;  // Trajectory blocks not frozen.
+  double seconds = 0.0;   // Wall time of the update (building + solving).
 };
 
 struct SlamResult {
@@ -48,10 +79,16 @@ struct SlamResult {
   // reads the GT times, never the GT poses), headings wrapped.
   std::vector<TimedPose> trajectory;
   std::vector<Landmark> landmarks;  // Sorted by id.
-  ceres::Solver::Summary summary;   // Of the last solve.
-  int total_iterations = 0;         // Over all outer rounds.
-  double solve_seconds = 0.0;       // Wall time of the whole RunSlam.
-  bool converged = false;           // Ceres reported CONVERGENCE.
+  // With compute_covariance: the covariance of (x, y, theta) at each
+  // trajectory time, and has_covariance set on every landmark.
+  std::vector<Eigen::Matrix3d> pose_covariances;
+  ceres::Solver::Summary summary;          // Of the last solve.
+  int total_iterations = 0;                // Over all outer rounds.
+  double solve_seconds = 0.0;              // Wall time of the whole RunSlam.
+  bool converged = false;                  // Ceres reported CONVERGENCE.
+  std::vector<IncrementalUpdate> updates;  // Incremental mode only.
+  // (scale, offset) of the range sensor; (1, 0) unless estimated.
+  Eigen::Vector2d range_calibration = Eigen::Vector2d(1.0, 0.0);
 };
 
 // Runs the solve. Returns false with a message on bad options or input, and
@@ -59,9 +96,20 @@ struct SlamResult {
 bool RunSlam(const Dataset& dataset, const SlamOptions& options,
              SlamResult* result, std::string* error);
 
+// The trajectory model the options ask for, around `mean`, covering every
+// time of `dataset`.
+std::unique_ptr<TrajectoryModel> CreateTrajectoryModel(
+    const Dataset& dataset, const SlamOptions& options,
+    std::shared_ptr<const MeanFunction> mean, std::string* error);
+
 // Times at which RunSlam reports the trajectory: every distinct observation
 // and GT_POSE time, or, when there are none, the odometry and prior times.
 std::vector<double> OutputTimes(const Dataset& dataset);
+
+// Prints the model, problem size, iterations, costs and times (and the
+// incremental updates' times) for people.
+void PrintSlamSummary(const SlamOptions& options, const SlamResult& result,
+                      std::ostream* out);
 
 // Writes the summary (options, costs, iterations, times) as JSON.
 bool WriteSummaryJson(const SlamOptions& options, const SlamResult& result,

@@ -4,6 +4,7 @@
 
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
+#include "rff_ceres/mean/prior_mean.h"
 #include "rff_ceres/metrics.h"
 #include "rff_ceres/simulate.h"
 
@@ -203,6 +204,157 @@ TEST(SlamSolverTest, OdometryMeanWithoutOdometryIsAnError) {
   SlamResult result;
   EXPECT_FALSE(RunSlam(dataset, options, &result, &error));
   EXPECT_THAT(error, HasSubstr("prior mean 'odometry'"));
+}
+
+TEST(SlamSolverTest, IncrementalModeTracksTheBatchSolution) {
+  SimulationOptions sim = PaperOptions(14);
+  sim.num_steps = 150;
+  sim.num_landmarks = 20;
+  sim.landmark_prior_sigma = 0.0;  // Landmarks enter as they are located.
+  Dataset dataset;
+  std::string error;
+  ASSERT_TRUE(Simulate(sim, &dataset, &error)) << error;
+  SlamOptions options = PaperSolverOptions();
+  SlamResult batch;
+  ASSERT_TRUE(RunSlam(dataset, options, &batch, &error)) << error;
+  EXPECT_TRUE(batch.updates.empty());
+
+  options.incremental.every = 5;
+  options.incremental.lag = 20.0;
+  SlamResult incremental;
+  ASSERT_TRUE(RunSlam(dataset, options, &incremental, &error)) << error;
+  // 4 observations per step: 600 measurements, an update every 5.
+  ASSERT_EQ(incremental.updates.size(), 120u);
+  EXPECT_EQ(incremental.updates.back().num_measurements, 600);
+  EXPECT_EQ(incremental.landmarks.size(), batch.landmarks.size());
+  // Three 50 s segments: with a 20 s lag the first is frozen by the end.
+  const int total_blocks = 9;
+  EXPECT_LT(incremental.updates.back().active_blocks, total_blocks);
+  const double batch_ape = ApeTranslation(dataset, batch);
+  const double incremental_ape = ApeTranslation(dataset, incremental);
+  EXPECT_LT(incremental_ape, 0.8);
+  EXPECT_LT(incremental_ape, 1.5 * batch_ape)
+      << "batch " << batch_ape << ", incremental " << incremental_ape;
+}
+
+TEST(SlamSolverTest, RangeCalibrationIsRecovered) {
+  SimulationOptions sim = PaperOptions(19);
+  sim.kind = MeasurementKind::kRange;
+  sim.num_landmarks = 20;
+  Dataset dataset;
+  std::string error;
+  ASSERT_TRUE(Simulate(sim, &dataset, &error)) << error;
+  // A sensor that reads 6% long with a 0.4 m offset.
+  for (Observation& o : dataset.observations) o.range = 1.06 * o.range + 0.4;
+  SlamOptions options = PaperSolverOptions();
+  SlamResult biased;
+  ASSERT_TRUE(RunSlam(dataset, options, &biased, &error)) << error;
+  options.problem.range_calibration.estimate = true;
+  SlamResult calibrated;
+  ASSERT_TRUE(RunSlam(dataset, options, &calibrated, &error)) << error;
+  EXPECT_NEAR(calibrated.range_calibration[0], 1.06, 0.01);
+  EXPECT_NEAR(calibrated.range_calibration[1], 0.4, 0.3);
+  EXPECT_LT(ApeTranslation(dataset, calibrated),
+            0.7 * ApeTranslation(dataset, biased));
+}
+
+TEST(SlamSolverTest, IncrementalModeRejectsOuterRounds) {
+  SimulationOptions sim = PaperOptions(15);
+  sim.num_steps = 20;
+  Dataset dataset;
+  std::string error;
+  ASSERT_TRUE(Simulate(sim, &dataset, &error)) << error;
+  SlamOptions options = PaperSolverOptions();
+  options.incremental.every = 5;
+  options.outer_rounds = 1;
+  SlamResult result;
+  EXPECT_FALSE(RunSlam(dataset, options, &result, &error));
+  EXPECT_THAT(error, HasSubstr("cannot be combined with the incremental"));
+}
+
+TEST(SlamSolverTest, OneThreadIsBitReproducibleAndTwoAgreeToRounding) {
+  SimulationOptions sim = PaperOptions(16);
+  sim.num_steps = 100;
+  Dataset dataset;
+  std::string error;
+  ASSERT_TRUE(Simulate(sim, &dataset, &error)) << error;
+  SlamOptions options = PaperSolverOptions();
+  options.solver.num_threads = 1;
+  SlamResult first, second, threaded;
+  ASSERT_TRUE(RunSlam(dataset, options, &first, &error)) << error;
+  ASSERT_TRUE(RunSlam(dataset, options, &second, &error)) << error;
+  options.solver.num_threads = 2;
+  ASSERT_TRUE(RunSlam(dataset, options, &threaded, &error)) << error;
+  ASSERT_EQ(first.trajectory.size(), second.trajectory.size());
+  ASSERT_EQ(first.trajectory.size(), threaded.trajectory.size());
+  double threaded_difference = 0.0;
+  for (std::size_t i = 0; i < first.trajectory.size(); ++i) {
+    // Bit for bit: the same sums in the same order.
+    EXPECT_EQ(first.trajectory[i].x, second.trajectory[i].x);
+    EXPECT_EQ(first.trajectory[i].y, second.trajectory[i].y);
+    EXPECT_EQ(first.trajectory[i].theta, second.trajectory[i].theta);
+    threaded_difference =
+        std::max({threaded_difference,
+                  std::abs(first.trajectory[i].x - threaded.trajectory[i].x),
+                  std::abs(first.trajectory[i].y - threaded.trajectory[i].y)});
+  }
+  // Ceres's threads sum in scheduling order: rounding-level differences.
+  EXPECT_LT(threaded_difference, 1e-6);
+}
+
+TEST(SlamSolverTest, OverflowingResidualIsNamed) {
+  SimulationOptions sim = PaperOptions(17);
+  sim.num_steps = 20;
+  Dataset dataset;
+  std::string error;
+  ASSERT_TRUE(Simulate(sim, &dataset, &error)) << error;
+  // Finite, valid fields whose whitened residual overflows to infinity.
+  Observation& o = dataset.observations[7];
+  o.range = 1e300;
+  o.sigma_range = 1e-300;
+  SlamResult result;
+  EXPECT_FALSE(RunSlam(dataset, PaperSolverOptions(), &result, &error));
+  EXPECT_THAT(error, HasSubstr("the solve failed"));
+  EXPECT_THAT(error, HasSubstr("is not finite"));
+  EXPECT_THAT(error, HasSubstr("of landmark " + std::to_string(o.id)));
+}
+
+TEST(SlamSolverTest, NothingToEstimateIsAnError) {
+  Dataset dataset;
+  dataset.pose_priors.push_back({{0.0, 0.0, 0.0, 0.0}, 0.1, 0.1});
+  SlamResult result;
+  std::string error;
+  EXPECT_FALSE(RunSlam(dataset, PaperSolverOptions(), &result, &error));
+  EXPECT_THAT(error, HasSubstr("no observations and no odometry"));
+}
+
+TEST(SlamProblemTest, LandmarkSeenByOneRangeIsNotDetermined) {
+  SimulationOptions sim = PaperOptions(18);
+  sim.num_steps = 30;
+  sim.kind = MeasurementKind::kRange;
+  Dataset dataset;
+  std::string error;
+  ASSERT_TRUE(Simulate(sim, &dataset, &error)) << error;
+  // Landmark 99, with no prior, seen by one range only.
+  Observation lonely = dataset.observations.front();
+  lonely.id = 99;
+  dataset.observations.push_back(lonely);
+  std::shared_ptr<const MeanFunction> mean =
+      BuildPriorMean("odometry", dataset, &error);
+  ASSERT_TRUE(mean) << error;
+  SlamOptions options = PaperSolverOptions();
+  std::unique_ptr<TrajectoryModel> model =
+      CreateTrajectoryModel(dataset, options, mean, &error);
+  ASSERT_TRUE(model) << error;
+  std::map<LandmarkId, Eigen::Vector2d> landmarks;
+  for (const Landmark& l : dataset.ground_truth_landmarks) {
+    landmarks[l.id] = Eigen::Vector2d(l.x, l.y);
+  }
+  landmarks[99] = Eigen::Vector2d(3.0, 4.0);
+  SlamProblem problem(model.get(), options.problem);
+  ASSERT_TRUE(problem.Build(dataset, landmarks, &error)) << error;
+  EXPECT_FALSE(problem.CheckLandmarksDetermined(1e12, &error));
+  EXPECT_THAT(error, HasSubstr("landmark 99 is not determined"));
 }
 
 }  // namespace

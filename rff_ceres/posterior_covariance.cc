@@ -1,0 +1,203 @@
+#include "rff_ceres/posterior_covariance.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <set>
+#include <utility>
+
+#include "Eigen/Eigenvalues"
+#include "ceres/covariance.h"
+#include "ceres/crs_matrix.h"
+#include "rff_ceres/io/text_parser.h"
+
+namespace rff {
+namespace {
+
+using RowMajorMatrix =
+    Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+
+// Landmarks whose own 2x2 block of J^T J is singular: the data fix fewer
+// than two directions of them (one range, or bearings from one place), so
+// the whole information matrix is singular too.
+std::vector<LandmarkId> UnconstrainedLandmarks(
+    SlamProblem* problem, const std::vector<LandmarkId>& ids) {
+  std::vector<double*> blocks;
+  for (const LandmarkId id : ids) blocks.push_back(problem->landmark_block(id));
+  ceres::Problem::EvaluateOptions evaluate;
+  evaluate.parameter_blocks = blocks;
+  ceres::CRSMatrix jacobian;
+  std::vector<LandmarkId> unconstrained;
+  if (blocks.empty() || !problem->problem()->Evaluate(
+                            evaluate, nullptr, nullptr, nullptr, &jacobian)) {
+    return unconstrained;
+  }
+  // Columns 2 k and 2 k + 1 belong to landmark k.
+  std::vector<Eigen::Matrix2d> information(ids.size(), Eigen::Matrix2d::Zero());
+  for (int row = 0; row < jacobian.num_rows; ++row) {
+    int landmark = -1;
+    Eigen::Vector2d gradient = Eigen::Vector2d::Zero();
+    for (int k = jacobian.rows[row]; k < jacobian.rows[row + 1]; ++k) {
+      landmark = jacobian.cols[k] / 2;
+      gradient[jacobian.cols[k] % 2] = jacobian.values[k];
+    }
+    if (landmark >= 0) information[landmark] += gradient * gradient.transpose();
+  }
+  for (std::size_t k = 0; k < ids.size(); ++k) {
+    const Eigen::Vector2d eigenvalues =
+        Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(information[k],
+                                                       Eigen::EigenvaluesOnly)
+            .eigenvalues();
+    if (!(eigenvalues[0] > 1e-12 * std::max(eigenvalues[1], 1e-300))) {
+      unconstrained.push_back(ids[k]);
+    }
+  }
+  return unconstrained;
+}
+
+std::string SingularMessage(SlamProblem* problem,
+                            const std::vector<Landmark>& landmarks,
+                            const CovarianceOptions& options) {
+  std::vector<LandmarkId> ids;
+  for (const Landmark& l : landmarks) ids.push_back(l.id);
+  const std::vector<LandmarkId> unconstrained =
+      UnconstrainedLandmarks(problem, ids);
+  std::string message =
+      std::string("posterior covariance: ceres::Covariance (") +
+      ceres::CovarianceAlgorithmTypeToString(options.algorithm) +
+      ") failed: the information matrix J^T J is singular";
+  if (unconstrained.empty()) return message;
+  message += "; the data do not fix the position of landmark";
+  if (unconstrained.size() > 1) message += "s";
+  for (std::size_t k = 0; k < unconstrained.size() && k < 10; ++k) {
+    message += (k == 0 ? " " : ", ") + std::to_string(unconstrained[k]);
+  }
+  if (unconstrained.size() > 10) {
+    message += " and " + std::to_string(unconstrained.size() - 10) + " more";
+  }
+  message +=
+      " (e.g. one range or bearings from one place only; a landmark prior "
+      "fixes it)";
+  return message;
+}
+
+}  // namespace
+
+bool ComputePosteriorCovariance(SlamProblem* problem,
+                                const TrajectoryModel& model,
+                                const std::vector<double>& times,
+                                const CovarianceOptions& options,
+                                std::vector<Eigen::Matrix3d>* pose_covariances,
+                                std::vector<Landmark>* landmarks,
+                                std::string* error) {
+  pose_covariances->clear();
+  if (options.num_threads < 1) {
+    *error = "posterior covariance: num_threads must be >= 1";
+    return false;
+  }
+  ceres::Problem* ceres_problem = problem->problem();
+
+  // The pose maps, and every pair of trajectory blocks that meet in one.
+  std::vector<PoseMap> maps;
+  maps.reserve(times.size());
+  std::set<std::pair<int, int>> block_pairs;
+  for (const double t : times) {
+    maps.push_back(model.PoseAt(t));
+    const std::vector<PoseTerm>& terms = maps.back().terms;
+    for (const PoseTerm& a : terms) {
+      if (a.block < 0 || a.block >= model.num_blocks() ||
+          !ceres_problem->HasParameterBlock(model.block(a.block))) {
+        *error = "posterior covariance: trajectory block " +
+                 std::to_string(a.block) +
+                 " of the pose at t = " + FormatNumber(t) +
+                 " is not in the problem";
+        return false;
+      }
+      for (const PoseTerm& b : terms) {
+        block_pairs.insert(std::minmax(a.block, b.block));
+      }
+    }
+  }
+  std::vector<std::pair<const double*, const double*>> requests;
+  for (const auto& [a, b] : block_pairs) {
+    requests.emplace_back(model.block(a), model.block(b));
+  }
+  for (const Landmark& l : *landmarks) {
+    const double* block = problem->landmark_block(l.id);
+    if (block == nullptr || !ceres_problem->HasParameterBlock(block)) {
+      *error = "posterior covariance: landmark " + std::to_string(l.id) +
+               " is not in the problem";
+      return false;
+    }
+    requests.emplace_back(block, block);
+  }
+  if (requests.empty()) return true;
+
+  ceres::Covariance::Options covariance_options;
+  covariance_options.algorithm_type = options.algorithm;
+  covariance_options.num_threads = options.num_threads;
+  ceres::Covariance covariance(covariance_options);
+  if (!covariance.Compute(requests, ceres_problem)) {
+    *error = SingularMessage(problem, *landmarks, options);
+    return false;
+  }
+
+  // Sigma(a, b) for a <= b, column-major.
+  std::map<std::pair<int, int>, Eigen::MatrixXd> sigma;
+  for (const auto& [a, b] : block_pairs) {
+    RowMajorMatrix block(model.block_size(a), model.block_size(b));
+    covariance.GetCovarianceBlock(model.block(a), model.block(b), block.data());
+    sigma.emplace(std::make_pair(a, b), block);
+  }
+  pose_covariances->reserve(times.size());
+  for (std::size_t k = 0; k < times.size(); ++k) {
+    const std::vector<PoseTerm>& terms = maps[k].terms;
+    Eigen::Matrix3d pose_covariance = Eigen::Matrix3d::Zero();
+    for (const PoseTerm& a : terms) {
+      for (const PoseTerm& b : terms) {
+        // Only Sigma(a, b) with a <= b is stored; Sigma(b, a) = Sigma(a, b)^T.
+        pose_covariance(a.coordinate, b.coordinate) +=
+            a.block <= b.block
+                ? a.phi->dot(sigma.at({a.block, b.block}) * *b.phi)
+                : b.phi->dot(sigma.at({b.block, a.block}) * *a.phi);
+      }
+    }
+    pose_covariance = 0.5 * (pose_covariance + pose_covariance.transpose());
+    if (!pose_covariance.allFinite() ||
+        !(pose_covariance.diagonal().minCoeff() >= 0.0)) {
+      *error = "posterior covariance: the covariance of the pose at t = " +
+               FormatNumber(times[k]) +
+               " is not finite or has a negative variance";
+      return false;
+    }
+    pose_covariances->push_back(pose_covariance);
+  }
+  for (Landmark& l : *landmarks) {
+    Eigen::Matrix<double, 2, 2, Eigen::RowMajor> block;
+    const double* parameters = problem->landmark_block(l.id);
+    covariance.GetCovarianceBlock(parameters, parameters, block.data());
+    if (!block.allFinite() || !(block(0, 0) >= 0.0) || !(block(1, 1) >= 0.0)) {
+      *error = "posterior covariance: the covariance of landmark " +
+               std::to_string(l.id) +
+               " is not finite or has a negative variance";
+      return false;
+    }
+    l.has_covariance = true;
+    l.sxx = block(0, 0);
+    l.sxy = 0.5 * (block(0, 1) + block(1, 0));
+    l.syy = block(1, 1);
+  }
+  return true;
+}
+
+bool ComputePosteriorCovariance(SlamProblem* problem,
+                                const TrajectoryModel& model,
+                                const std::vector<double>& times,
+                                std::vector<Eigen::Matrix3d>* pose_covariances,
+                                std::vector<Landmark>* landmarks,
+                                std::string* error) {
+  return ComputePosteriorCovariance(problem, model, times, CovarianceOptions(),
+                                    pose_covariances, landmarks, error);
+}
+
+}  // namespace rff

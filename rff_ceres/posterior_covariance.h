@@ -1,0 +1,56 @@
+// Posterior uncertainty of the MAP solution (Laplace approximation): the
+// covariance of the trajectory blocks after landmark elimination, pushed
+// through the affine pose map, Var x(t) = sum_ab Phi_a(t)^T Sigma_ab Phi_b(t),
+// and the 2x2 covariance of every landmark. See docs/uncertainty.md.
+//
+// Sigma = (J^T J)^-1 with J the Jacobian of the whitened residuals at the
+// current parameter values. Residuals with a robust loss enter through the
+// robustified Jacobian (Ceres's Covariance convention), so down-weighted
+// outliers count for less.
+#ifndef RFF_CERES_POSTERIOR_COVARIANCE_H_
+#define RFF_CERES_POSTERIOR_COVARIANCE_H_
+
+#include <string>
+#include <vector>
+
+#include "Eigen/Core"
+#include "ceres/types.h"
+#include "rff_ceres/slam_problem.h"
+#include "rff_ceres/trajectory_model.h"
+#include "rff_ceres/types.h"
+
+namespace rff {
+
+struct CovarianceOptions {
+  // SPARSE_QR (SuiteSparseQR) scales to long runs but needs a full-rank
+  // Jacobian; DENSE_SVD is O(n^3) in the number of parameters.
+  ceres::CovarianceAlgorithmType algorithm = ceres::SPARSE_QR;
+  // Threads of the column solves (Ceres parallelises over the columns of
+  // the inverse it needs).
+  int num_threads = 2;
+};
+
+// For a solved `problem` over `model`: fills `pose_covariances` (one per time
+// of `times`) and the covariance fields of each entry of `landmarks` (matched
+// by id to the problem's landmark blocks; has_covariance set). Returns false
+// with a message when the information matrix is singular (naming the
+// landmarks that the data leave unconstrained) or the result is not finite.
+bool ComputePosteriorCovariance(SlamProblem* problem,
+                                const TrajectoryModel& model,
+                                const std::vector<double>& times,
+                                const CovarianceOptions& options,
+                                std::vector<Eigen::Matrix3d>* pose_covariances,
+                                std::vector<Landmark>* landmarks,
+                                std::string* error);
+
+// The same with the default CovarianceOptions.
+bool ComputePosteriorCovariance(SlamProblem* problem,
+                                const TrajectoryModel& model,
+                                const std::vector<double>& times,
+                                std::vector<Eigen::Matrix3d>* pose_covariances,
+                                std::vector<Landmark>* landmarks,
+                                std::string* error);
+
+}  // namespace rff
+
+#endif  // RFF_CERES_POSTERIOR_COVARIANCE_H_
