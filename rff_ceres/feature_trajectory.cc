@@ -114,8 +114,9 @@ PoseMap FeatureTrajectory::PoseAt(double t) const {
   return map;
 }
 
-void FeatureTrajectory::AddPriorCosts(ceres::Problem* problem) {
-  for (int b = 0; b < num_blocks(); ++b) {
+void FeatureTrajectory::AddPriorCosts(ceres::Problem* problem, int begin,
+                                      int end) {
+  for (int b = begin; b < end; ++b) {
     problem->AddResidualBlock(new WeightPriorCost(block_size(b)), nullptr,
                               mutable_block(b));
   }

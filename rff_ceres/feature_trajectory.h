@@ -63,7 +63,8 @@ class FeatureTrajectory : public TrajectoryModel {
   }
   int num_segments() const { return static_cast<int>(segments_.size()); }
   PoseMap PoseAt(double t) const override;
-  void AddPriorCosts(ceres::Problem* problem) override;
+  using TrajectoryModel::AddPriorCosts;
+  void AddPriorCosts(ceres::Problem* problem, int begin, int end) override;
 
   double origin() const { return origin_; }
   const MeanFunction& mean() const override { return *mean_; }

@@ -100,7 +100,6 @@ bool SlamProblem::Begin(const std::vector<LandmarkId>& landmark_ids,
     problem_->AddParameterBlock(model_->mutable_block(b),
                                 model_->block_size(b));
   }
-  model_->AddPriorCosts(problem_.get());
   const RangeCalibrationOptions& calibration = options_.range_calibration;
   if (calibration.estimate) {
     for (const double sigma :
@@ -194,6 +193,7 @@ bool SlamProblem::Build(const Dataset& dataset,
   std::vector<LandmarkId> ids;
   for (const auto& [id, position] : landmarks) ids.push_back(id);
   if (!Begin(ids, error)) return false;
+  model_->AddPriorCosts(problem_.get());
   for (const auto& [id, position] : landmarks) AddLandmark(id, position);
   for (const PosePrior& p : dataset.pose_priors) AddPosePrior(p);
   for (const LandmarkPrior& p : dataset.landmark_priors) AddLandmarkPrior(p);

@@ -65,9 +65,10 @@ class SlamProblem {
              std::string* error);
 
   // The same problem built piece by piece (incremental mode): Begin() adds
-  // the trajectory blocks and their prior and makes room for the landmarks
-  // with the given ids, then residuals are added as the data arrives. A
-  // landmark must be added before its prior or observations.
+  // the trajectory blocks (and the range calibration) and makes room for the
+  // landmarks with the given ids, then the trajectory prior (through the
+  // model) and residuals are added as the data arrives. A landmark must be
+  // added before its prior or observations.
   bool Begin(const std::vector<LandmarkId>& landmark_ids, std::string* error);
   void AddLandmark(LandmarkId id, const Eigen::Vector2d& initial);
   bool has_landmark(LandmarkId id) const { return added_.count(id) > 0; }

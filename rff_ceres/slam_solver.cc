@@ -303,6 +303,7 @@ bool SolveIncremental(const Dataset& dataset, const SlamOptions& options,
   const std::vector<PreintegratedOdometry> odometry =
       slam.OdometryResiduals(dataset);
   std::size_t next_odometry = 0, next_prior = 0;
+  int prior_end = 0;  // Trajectory prior terms added for blocks below this.
   std::vector<Observation> pending;  // Of landmarks not located yet.
 
   const std::vector<Observation>& observations = dataset.observations;
@@ -350,6 +351,17 @@ bool SolveIncremental(const Dataset& dataset, const SlamOptions& options,
       }
       pending.swap(still_pending);
     }
+
+    // Prior terms of the blocks in use; a WNOA term to a state still in the
+    // future would pin the present to the prior mean.
+    int used_end = prior_end;
+    for (int b = prior_end; b < model->num_blocks(); ++b) {
+      if (touched[b] > -std::numeric_limits<double>::infinity()) {
+        used_end = b + 1;
+      }
+    }
+    model->AddPriorCosts(ceres_problem, prior_end, used_end);
+    prior_end = used_end;
 
     IncrementalUpdate update;
     update.t = now;
@@ -468,8 +480,9 @@ bool RunSlam(const Dataset& dataset, const SlamOptions& options,
   }
   double longest_range = 0.0;
   for (const Observation& o : dataset.observations) {
-    if (o.HasRange())
+    if (o.HasRange()) {
       longest_range = std::max(longest_range, std::abs(o.range));
+    }
   }
   initial_extent += longest_range;
 

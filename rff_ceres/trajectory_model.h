@@ -32,8 +32,13 @@ class TrajectoryModel {
   // model's blocks.
   virtual PoseMap PoseAt(double t) const = 0;
 
-  // Adds the prior over the blocks (whitened weights, GP motion prior).
-  virtual void AddPriorCosts(ceres::Problem* problem) = 0;
+  // Adds the prior terms over the blocks (whitened weights, GP motion prior)
+  // whose newest block lies in [begin, end); blocks are in time order, so the
+  // incremental mode adds each term once its blocks come into use.
+  virtual void AddPriorCosts(ceres::Problem* problem, int begin, int end) = 0;
+  void AddPriorCosts(ceres::Problem* problem) {
+    AddPriorCosts(problem, 0, num_blocks());
+  }
 
   // The prior mean mu(t) the blocks deviate from; replaced between the outer
   // rounds of the smoothing-spline prior (paper III-B.2).

@@ -163,14 +163,18 @@ PoseMap WnoaTrajectory::PoseAt(double t) const {
   return map;
 }
 
-void WnoaTrajectory::AddPriorCosts(ceres::Problem* problem) {
-  WnoaInitialStateCost::Vector6 sigma;
-  sigma << options_.initial_position_sigma, options_.initial_position_sigma,
-      options_.initial_heading_sigma, options_.initial_velocity_sigma,
-      options_.initial_velocity_sigma, options_.initial_angular_velocity_sigma;
-  problem->AddResidualBlock(new WnoaInitialStateCost(sigma), nullptr,
-                            mutable_block(0));
-  for (int i = 0; i + 1 < num_blocks(); ++i) {
+void WnoaTrajectory::AddPriorCosts(ceres::Problem* problem, int begin,
+                                   int end) {
+  if (begin == 0 && end > 0) {
+    WnoaInitialStateCost::Vector6 sigma;
+    sigma << options_.initial_position_sigma, options_.initial_position_sigma,
+        options_.initial_heading_sigma, options_.initial_velocity_sigma,
+        options_.initial_velocity_sigma,
+        options_.initial_angular_velocity_sigma;
+    problem->AddResidualBlock(new WnoaInitialStateCost(sigma), nullptr,
+                              mutable_block(0));
+  }
+  for (int i = std::max(begin, 1) - 1; i + 1 < end; ++i) {
     problem->AddResidualBlock(
         new WnoaPriorCost(times_[i + 1] - times_[i], options_.position_qc,
                           options_.position_qc, options_.heading_qc),

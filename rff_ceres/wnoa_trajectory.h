@@ -71,8 +71,9 @@ class WnoaTrajectory : public TrajectoryModel {
   double* mutable_block(int block) override;
   PoseMap PoseAt(double t) const override;
   // The initial-state prior on block 0 and one WnoaPriorCost between every
-  // pair of consecutive states.
-  void AddPriorCosts(ceres::Problem* problem) override;
+  // pair of consecutive states (a pair belongs to its later state).
+  using TrajectoryModel::AddPriorCosts;
+  void AddPriorCosts(ceres::Problem* problem, int begin, int end) override;
   const MeanFunction& mean() const override;
   void set_mean(std::shared_ptr<const MeanFunction> mean) override;
 

@@ -2,7 +2,8 @@
 # Median APE-trans of rff_slam over the simulated benchmark sets (paper
 # protocol; seeds 1-5 x {10, 50} landmarks per cell), as a Markdown table:
 #   scripts/synthetic_table.sh BUILD_DIR SYNTHETIC_DIR [extra rff_slam flags]
-# Uses configs/synthetic_{range_bearing,range,bearing}.flags.
+# Uses configs/synthetic_{range_bearing,range,bearing}${SUFFIX}.flags, so
+# SUFFIX=_wnoa gives the LTV-SDE baseline's table.
 set -euo pipefail
 build=$1 dir=$2
 shift 2
@@ -21,7 +22,8 @@ for kind in rb range bearing; do
     for seed in 1 2 3 4 5; do
       for landmarks in 10 50; do
         file="$dir/s${seed}_${kind}_L${landmarks}_o${odometry}.rffd"
-        if out=$("$build/rff_slam" --flagfile="$root/configs/$config.flags" \
+        if out=$("$build/rff_slam" \
+                 --flagfile="$root/configs/$config${SUFFIX:-}.flags" \
                  --dataset="$file" "$@" 2>/dev/null); then
           results+=$(echo "$out" | awk '/^APE translation/ {a = $4}
                                         /s total/ {t = $6}

@@ -41,8 +41,8 @@ class LineTrajectory : public TrajectoryModel {
     for (int c = 0; c < 3; ++c) map.terms.push_back({c, c, phi});
     return map;
   }
-  void AddPriorCosts(ceres::Problem* problem) override {
-    for (int b = 0; b < 3; ++b) {
+  void AddPriorCosts(ceres::Problem* problem, int begin, int end) override {
+    for (int b = begin; b < end; ++b) {
       problem->AddResidualBlock(new WeightPriorCost(2), nullptr,
                                 mutable_block(b));
     }
