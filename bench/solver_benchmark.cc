@@ -1,0 +1,574 @@
+// Google Benchmark suite of the RFF-SLAM solver (see bench/README.md):
+//
+// - BM_Iteration/N/D/L/solver/seg: one Levenberg-Marquardt iteration
+//   (linearisation + Schur linear solve), with its ratio to the BLAS-3 bound.
+// - BM_GramLowerBound/rows/D: a dense BLAS-3 Gram J^T J (Eigen SYRK).
+// - BM_FullSolve/N: the whole RunSlam, windowed, fixed iterations.
+// - BM_FeatureCache/N/D/cached: building the pose maps with and without the
+//   per-time feature cache.
+//
+// Flags of our own (removed before Google Benchmark parses the rest):
+//   --large      also register the N = 1e6 BM_Iteration rows
+//   --threads=K  Ceres threads (default 1: the BLAS-3 bound is one thread)
+//   --lm_iterations=K  LM iterations per BM_Iteration solve (default 3)
+#include <sys/resource.h>
+#include <time.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <map>
+#include <memory>
+#include <numeric>
+#include <string>
+#include <tuple>
+#include <vector>
+
+#include "Eigen/Core"
+#include "benchmark/benchmark.h"
+#include "ceres/solver.h"
+#include "rff_ceres/feature_trajectory.h"
+#include "rff_ceres/io/text_parser.h"
+#include "rff_ceres/landmark_init.h"
+#include "rff_ceres/mean/prior_mean.h"
+#include "rff_ceres/simulate.h"
+#include "rff_ceres/slam_problem.h"
+#include "rff_ceres/slam_solver.h"
+
+namespace rff {
+namespace {
+
+int g_threads = 1;
+int g_lm_iterations = 3;
+
+// Observations per pose (1 Hz): N observations span N / 10 seconds.
+constexpr int kObservationsPerStep = 10;
+// Each landmark is seen from about this many steps either side of its anchor
+// (more when there are too few landmarks to give every pose 10 candidates).
+constexpr int kVisibilitySteps = 10;
+
+const char* const kSolverNames[] = {"DENSE_SCHUR", "SPARSE_SCHUR",
+                                    "ITERATIVE_SCHUR"};
+
+double PeakRssMiB() {
+  rusage usage;
+  getrusage(RUSAGE_SELF, &usage);
+  return usage.ru_maxrss / 1024.0;  // Linux reports KiB.
+}
+
+// CPU seconds of the whole process (all threads).
+double ProcessCpuSeconds() {
+  timespec now;
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &now);
+  return now.tv_sec + 1e-9 * now.tv_nsec;
+}
+
+double Seconds(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
+      .count();
+}
+
+// N range-bearing observations (10 per pose, 1 Hz) along the paper's
+// wandering unicycle from Simulate (its odometry, first-pose prior and ground
+// truth kept). Simulate draws landmarks from the whole run; here the L
+// landmarks are anchored along the path instead and each is observed only
+// from a local stretch, as a real sensor would, so the reduced system stays
+// banded. Every landmark gets a 5 m prior, as in the paper's protocol.
+bool MakeDataset(int num_observations, int num_landmarks, Dataset* dataset,
+                 std::string* error) {
+  const int steps = num_observations / kObservationsPerStep;
+  if (steps < 2 || num_landmarks < kObservationsPerStep) {
+    *error = "need N >= 20 and L >= 10";
+    return false;
+  }
+  SimulationOptions sim = PaperOptions(/*seed=*/1);
+  sim.num_steps = steps;
+  sim.num_landmarks = 1;  // Replaced below.
+  sim.observations_per_step = 1;
+  if (!Simulate(sim, dataset, error)) return false;
+  dataset->observations.clear();
+  dataset->landmark_priors.clear();
+  dataset->ground_truth_landmarks.clear();
+  const std::vector<TimedPose>& poses = dataset->ground_truth;
+
+  SimulationRandom random(/*seed=*/7);
+  for (int j = 0; j < num_landmarks; ++j) {
+    const int anchor = std::min(
+        steps - 1, static_cast<int>((j + 0.5) * steps / num_landmarks));
+    const double r = random.Uniform(3.0, 15.0);
+    const double a = random.Uniform(-M_PI, M_PI);
+    Landmark landmark;
+    landmark.id = j;
+    landmark.x = poses[anchor].x + r * std::cos(a);
+    landmark.y = poses[anchor].y + r * std::sin(a);
+    dataset->ground_truth_landmarks.push_back(landmark);
+    LandmarkPrior prior;
+    prior.id = j;
+    prior.sigma = sim.landmark_prior_sigma;
+    prior.x = landmark.x + prior.sigma * random.Normal();
+    prior.y = landmark.y + prior.sigma * random.Normal();
+    dataset->landmark_priors.push_back(prior);
+  }
+  const int half_window =
+      std::max(kObservationsPerStep / 2 + 1,
+               static_cast<int>(std::ceil(kVisibilitySteps *
+                                          double(num_landmarks) / steps)));
+  std::vector<int> candidates;
+  for (int i = 0; i < steps; ++i) {
+    const int centre =
+        static_cast<int>(std::lround((i + 0.5) * num_landmarks / steps - 0.5));
+    int lo = std::max(0, centre - half_window);
+    int hi = std::min(num_landmarks - 1, centre + half_window);
+    while (hi - lo + 1 < kObservationsPerStep) {  // At the ends of the run.
+      if (lo > 0) --lo;
+      if (hi < num_landmarks - 1) ++hi;
+    }
+    candidates.resize(hi - lo + 1);
+    std::iota(candidates.begin(), candidates.end(), lo);
+    for (int k = 0; k < kObservationsPerStep; ++k) {
+      std::swap(candidates[k],
+                candidates[k + random.Index(candidates.size() - k)]);
+      const Landmark& l = dataset->ground_truth_landmarks[candidates[k]];
+      const double dx = l.x - poses[i].x, dy = l.y - poses[i].y;
+      Observation o;
+      o.type = ObservationType::kRangeBearing;
+      o.t = poses[i].t;
+      o.id = l.id;
+      o.sigma_range = sim.sigma_range;
+      o.sigma_bearing = sim.sigma_bearing;
+      o.range = std::hypot(dx, dy) + o.sigma_range * random.Normal();
+      o.bearing = WrapAngle(std::atan2(dy, dx) - poses[i].theta +
+                            o.sigma_bearing * random.Normal());
+      dataset->observations.push_back(o);
+    }
+  }
+  return true;
+}
+
+// The settings of configs/synthetic_*.flags (RBF, Hilbert features, 5 s
+// lengthscale) with D features per coordinate and per segment, and windows of
+// `segment` seconds overlapping by 30 % (50 s / 15 s in the configs); 0: one
+// global feature map.
+SlamOptions BenchOptions(int num_features, double segment,
+                         const std::string& solver) {
+  SlamOptions options;
+  options.prior_mean = "auto";  // Odometry: the dataset has ODOM.
+  FeatureTrajectoryOptions& t = options.trajectory;
+  t.position_kernel.name = "rbf";
+  t.position_kernel.lengthscale = 5.0;
+  t.position_kernel.variance = 100.0;
+  t.heading_kernel = t.position_kernel;
+  t.heading_kernel.variance = 0.25;
+  t.family = "hilbert";
+  t.num_position_features = num_features;
+  t.num_heading_features = num_features;
+  t.segment_length = segment;
+  t.segment_overlap = 0.3 * segment;
+  options.solver.linear_solver = solver;
+  options.solver.num_threads = g_threads;
+  // No early stop: every solve does exactly max_iterations iterations.
+  options.solver.function_tolerance = 0.0;
+  options.solver.gradient_tolerance = 0.0;
+  options.solver.parameter_tolerance = 0.0;
+  return options;
+}
+
+// The datasets of the last (N, L), shared by the rows that differ in D,
+// segment or solver only.
+const Dataset& CachedDataset(int num_observations, int num_landmarks) {
+  static std::pair<int, int> key(-1, -1);
+  static Dataset dataset;
+  if (key != std::make_pair(num_observations, num_landmarks)) {
+    dataset = Dataset();
+    std::string error;
+    if (!MakeDataset(num_observations, num_landmarks, &dataset, &error)) {
+      fprintf(stderr, "MakeDataset: %s\n", error.c_str());
+      std::exit(1);
+    }
+    key = {num_observations, num_landmarks};
+  }
+  return dataset;
+}
+
+struct Timing {
+  double wall = 1e300;  // Seconds.
+  double cpu = 1e300;   // Process CPU seconds: robust on a loaded machine.
+};
+
+// One dense Gram G = J^T J (the lower triangle, Eigen's SYRK) for J of
+// rows x cols; the best of `repeats`.
+Timing TimeGram(int rows, int cols, int repeats) {
+  const Eigen::MatrixXd jacobian = Eigen::MatrixXd::Random(rows, cols);
+  Eigen::MatrixXd gram(cols, cols);
+  Timing best;
+  for (int r = 0; r < repeats; ++r) {
+    gram.setZero();
+    const double cpu = ProcessCpuSeconds();
+    const auto start = std::chrono::steady_clock::now();
+    gram.selfadjointView<Eigen::Lower>().rankUpdate(jacobian.transpose());
+    benchmark::DoNotOptimize(gram.data());
+    best.wall = std::min(best.wall, Seconds(start));
+    best.cpu = std::min(best.cpu, ProcessCpuSeconds() - cpu);
+  }
+  return best;
+}
+
+// Dense Gram time of `rows` x `cols`, timed on a slice of at most ~2^21
+// entries and scaled by rows (SYRK costs rows * cols^2).
+Timing GramLowerBound(long rows, int cols) {
+  const long slice =
+      std::min<long>(rows, std::max<long>(cols, (1L << 21) / cols));
+  Timing t = TimeGram(static_cast<int>(slice), cols, 3);
+  t.wall *= double(rows) / slice;
+  t.cpu *= double(rows) / slice;
+  return t;
+}
+
+// Everything RunSlam builds before ceres::Solve, kept across the benchmark's
+// repeated calls and its solver rows.
+struct ProblemSetup {
+  std::tuple<int, int, int, int> key{-1, -1, -1, -1};  // N, D, L, segment
+  std::unique_ptr<FeatureTrajectory> model;
+  std::unique_ptr<SlamProblem> problem;
+  std::vector<double*> blocks;
+  std::vector<std::vector<double>> initial_values;
+  int num_segments = 0;
+  long trajectory_rows = 0;  // Scalar residuals touching trajectory blocks.
+  int trajectory_params = 0;
+  double build_seconds = 0.0;
+  Timing gram;  // The dense lower bound, see CachedSetup.
+
+  void Reset() {
+    for (std::size_t i = 0; i < blocks.size(); ++i) {
+      std::copy(initial_values[i].begin(), initial_values[i].end(), blocks[i]);
+    }
+  }
+};
+
+ProblemSetup& CachedSetup(int n, int d, int l, int segment) {
+  static ProblemSetup setup;
+  const auto key = std::make_tuple(n, d, l, segment);
+  if (setup.key == key) return setup;
+  setup = ProblemSetup();
+  const Dataset& dataset = CachedDataset(n, l);
+  const SlamOptions options = BenchOptions(d, segment, "DENSE_SCHUR");
+  std::string error;
+  const auto start = std::chrono::steady_clock::now();
+  std::shared_ptr<const MeanFunction> mean =
+      BuildPriorMean(options.prior_mean, dataset, &error);
+  std::map<LandmarkId, Eigen::Vector2d> landmarks;
+  bool ok = mean != nullptr;
+  if (ok) {
+    // RunSlam's window: every time the dataset mentions (here the GT and
+    // odometry times cover the observations).
+    const double t_begin = dataset.ground_truth.front().t;
+    const double t_end = dataset.ground_truth.back().t;
+    setup.model = FeatureTrajectory::Create(options.trajectory, mean, t_begin,
+                                            t_end, &error);
+    ok = setup.model != nullptr &&
+         InitializeLandmarks(
+             dataset, [&](double t) { return mean->Evaluate(t); }, &landmarks,
+             &error);
+  }
+  if (ok) {
+    setup.problem =
+        std::make_unique<SlamProblem>(setup.model.get(), options.problem);
+    ok = setup.problem->Build(dataset, landmarks, &error);
+  }
+  if (!ok) {
+    fprintf(stderr, "setup N=%d D=%d L=%d: %s\n", n, d, l, error.c_str());
+    std::exit(1);
+  }
+  setup.build_seconds = Seconds(start);
+  ceres::Problem* problem = setup.problem->problem();
+  problem->GetParameterBlocks(&setup.blocks);
+  for (double* block : setup.blocks) {
+    setup.initial_values.emplace_back(
+        block, block + problem->ParameterBlockSize(block));
+  }
+  setup.num_segments = setup.model->num_segments();
+  for (int b = 0; b < setup.model->num_blocks(); ++b) {
+    setup.trajectory_params += setup.model->block_size(b);
+  }
+  // Rows of observations, odometry and pose priors: all residuals minus the
+  // weight priors (one row per weight) and the landmark priors (two each).
+  setup.trajectory_rows = problem->NumResiduals() - setup.trajectory_params -
+                          2L * dataset.landmark_priors.size();
+  // The bound: per segment, a dense Gram of that segment's share of the rows
+  // over its 3D weights, summed over segments (cross-segment blocks of the
+  // overlaps and the landmark columns left out, so it stays a lower bound).
+  const int cols = setup.trajectory_params / setup.num_segments;
+  setup.gram = GramLowerBound(
+      (setup.trajectory_rows + setup.num_segments - 1) / setup.num_segments,
+      cols);
+  setup.gram.wall *= setup.num_segments;
+  setup.gram.cpu *= setup.num_segments;
+  setup.key = key;
+  return setup;
+}
+
+// Mean of per-iteration values over the iterations after the first step
+// (iteration 1 carries one-off work such as the symbolic factorisation).
+double SteadyMean(const ceres::Solver::Summary& summary,
+                  double ceres::IterationSummary::*field) {
+  const auto& it = summary.iterations;
+  if (it.size() < 2) return 0.0;
+  const std::size_t first = it.size() > 2 ? 2 : 1;
+  double sum = 0.0;
+  for (std::size_t i = first; i < it.size(); ++i) sum += it[i].*field;
+  return sum / (it.size() - first);
+}
+
+void BM_Iteration(benchmark::State& state) {
+  const int n = static_cast<int>(state.range(0));
+  const int d = static_cast<int>(state.range(1));
+  const int l = static_cast<int>(state.range(2));
+  const std::string solver = kSolverNames[state.range(3)];
+  const int segment = static_cast<int>(state.range(4));
+  ProblemSetup& setup = CachedSetup(n, d, l, segment);
+
+  SlamOptions options = BenchOptions(d, segment, solver);
+  options.solver.max_iterations = g_lm_iterations;
+  ceres::Solver::Options ceres_options;
+  std::string error;
+  if (!ToCeresOptions(options.solver, &ceres_options, &error)) {
+    state.SkipWithError(error.c_str());
+    return;
+  }
+
+  double jacobian = 0, residual = 0, linear = 0, first_linear = 0;
+  double preprocess = 0, cg_iterations = 0, cpu_fraction = 0;
+  int runs = 0;
+  ceres::Solver::Summary summary;
+  for (auto _ : state) {
+    state.PauseTiming();
+    setup.Reset();
+    // The preprocessor edits the ordering it is given: a fresh one per solve.
+    ceres_options.linear_solver_ordering = setup.problem->Ordering();
+    state.ResumeTiming();
+    const double cpu = ProcessCpuSeconds();
+    const auto start = std::chrono::steady_clock::now();
+    ceres::Solve(ceres_options, setup.problem->problem(), &summary);
+    const double wall = Seconds(start);
+    state.PauseTiming();
+    cpu_fraction += (ProcessCpuSeconds() - cpu) / wall;
+    if (summary.termination_type == ceres::FAILURE ||
+        summary.iterations.size() < 2) {
+      state.SkipWithError(("solve failed: " + summary.message).c_str());
+      state.ResumeTiming();
+      break;
+    }
+    ++runs;
+    jacobian += summary.jacobian_evaluation_time_in_seconds /
+                std::max(1, summary.num_jacobian_evaluations);
+    residual += summary.residual_evaluation_time_in_seconds /
+                std::max(1, summary.num_residual_evaluations);
+    linear += SteadyMean(summary,
+                         &ceres::IterationSummary::step_solver_time_in_seconds);
+    first_linear += summary.iterations[1].step_solver_time_in_seconds;
+    preprocess += summary.preprocessor_time_in_seconds;
+    double cg = 0;
+    for (std::size_t i = 1; i < summary.iterations.size(); ++i) {
+      cg += summary.iterations[i].linear_solver_iterations;
+    }
+    cg_iterations += cg / (summary.iterations.size() - 1);
+    state.ResumeTiming();
+  }
+  if (runs == 0) return;
+  const double ms = 1e3 / runs;
+  const double iteration = (jacobian + linear + residual) * ms;
+  state.counters["iteration_ms"] = iteration;
+  state.counters["jacobian_ms"] = jacobian * ms;
+  state.counters["linear_ms"] = linear * ms;
+  state.counters["first_linear_ms"] = first_linear * ms;
+  state.counters["residual_ms"] = residual * ms;
+  state.counters["preprocess_ms"] = preprocess * ms;
+  state.counters["linear_iterations"] = cg_iterations / runs;
+  state.counters["blas3_ms"] = setup.gram.wall * 1e3;
+  state.counters["ratio_to_blas3"] = iteration / (setup.gram.wall * 1e3);
+  // The same on CPU time: Ceres's wall-clock parts scaled by the solve's
+  // CPU / wall fraction (equal to the above on an idle machine, one thread).
+  const double iteration_cpu = iteration * cpu_fraction / runs;
+  state.counters["iteration_cpu_ms"] = iteration_cpu;
+  state.counters["blas3_cpu_ms"] = setup.gram.cpu * 1e3;
+  state.counters["ratio_to_blas3_cpu"] = iteration_cpu / (setup.gram.cpu * 1e3);
+  state.counters["segments"] = setup.num_segments;
+  state.counters["traj_params"] = setup.trajectory_params;
+  state.counters["traj_rows"] = setup.trajectory_rows;
+  state.counters["residual_blocks"] = summary.num_residual_blocks;
+  state.counters["build_ms"] = setup.build_seconds * 1e3;
+  state.counters["peak_rss_MiB"] = PeakRssMiB();
+  state.SetLabel(solver + (segment > 0
+                               ? " windows " + std::to_string(segment) + "s/" +
+                                     FormatNumber(0.3 * segment) + "s"
+                               : " global map"));
+}
+
+void BM_GramLowerBound(benchmark::State& state) {
+  const int rows = static_cast<int>(state.range(0));
+  const int cols = 3 * static_cast<int>(state.range(1));
+  const Eigen::MatrixXd jacobian = Eigen::MatrixXd::Random(rows, cols);
+  Eigen::MatrixXd gram(cols, cols);
+  for (auto _ : state) {
+    gram.setZero();
+    gram.selfadjointView<Eigen::Lower>().rankUpdate(jacobian.transpose());
+    benchmark::DoNotOptimize(gram.data());
+    benchmark::ClobberMemory();
+  }
+  // SYRK: rows * cols * (cols + 1) / 2 multiply-adds, 2 flops each.
+  state.counters["GFLOPs"] =
+      benchmark::Counter(2.0 * rows * cols * (cols + 1.0) / 2.0 * 1e-9,
+                         benchmark::Counter::kIsIterationInvariantRate);
+  state.SetLabel("J " + std::to_string(rows) + " x " + std::to_string(cols));
+}
+
+void BM_FullSolve(benchmark::State& state) {
+  const int n = static_cast<int>(state.range(0));
+  const int l = n / 50;
+  const Dataset& dataset = CachedDataset(n, l);
+  SlamOptions options = BenchOptions(24, 50, "SPARSE_SCHUR");
+  options.solver.max_iterations = 10;
+  SlamResult result;
+  std::string error;
+  for (auto _ : state) {
+    if (!RunSlam(dataset, options, &result, &error)) {
+      state.SkipWithError(error.c_str());
+      return;
+    }
+  }
+  state.counters["iterations"] = result.total_iterations;
+  state.counters["ms_per_iteration"] =
+      1e3 * result.summary.minimizer_time_in_seconds / result.total_iterations;
+  state.counters["ceres_ms"] = 1e3 * result.summary.total_time_in_seconds;
+  // Prior mean, landmark set-up, problem build, checks, output poses.
+  state.counters["outside_ceres_ms"] =
+      1e3 * (result.solve_seconds - result.summary.total_time_in_seconds);
+  state.counters["peak_rss_MiB"] = PeakRssMiB();
+  state.counters["landmarks"] = l;
+  state.SetLabel("SPARSE_SCHUR D=24 windows 50s/15s L=N/50, 10 iterations");
+}
+
+// Pose maps of every observation, as SlamProblem::Build makes them, from a
+// fresh trajectory (empty cache). cached = 1: the real times, 10 observations
+// per time share one feature evaluation. cached = 0: every observation time
+// moved by a few ulps so that no two coincide, which is what the build would
+// cost without the cache (one evaluation and one vector per observation).
+void BM_FeatureCache(benchmark::State& state) {
+  const int n = static_cast<int>(state.range(0));
+  const int d = static_cast<int>(state.range(1));
+  const bool cached = state.range(2) != 0;
+  const Dataset& dataset = CachedDataset(n, n / 50);
+  std::vector<double> times;
+  double previous = -1e300;
+  for (const Observation& o : dataset.observations) {
+    double t = o.t;
+    if (!cached && t <= previous) t = std::nextafter(previous, 1e300);
+    times.push_back(t);
+    previous = t;
+  }
+  const SlamOptions options = BenchOptions(d, 50, "DENSE_SCHUR");
+  std::string error;
+  std::shared_ptr<const MeanFunction> mean =
+      BuildPriorMean(options.prior_mean, dataset, &error);
+  std::size_t distinct = 0;
+  for (auto _ : state) {
+    state.PauseTiming();
+    auto model = FeatureTrajectory::Create(options.trajectory, mean,
+                                           times.front(), times.back(), &error);
+    std::vector<PoseMap> maps;
+    maps.reserve(times.size());
+    state.ResumeTiming();
+    for (const double t : times) maps.push_back(model->PoseAt(t));
+    state.PauseTiming();
+    std::map<const double*, int> vectors;
+    for (const PoseMap& map : maps) {
+      for (const PoseTerm& term : map.terms) vectors[term.phi->data()] = 1;
+    }
+    distinct = vectors.size();
+    maps.clear();
+    model.reset();
+    state.ResumeTiming();
+  }
+  state.counters["feature_vectors"] = distinct;
+  state.counters["feature_MiB"] = distinct * d * 8.0 / (1 << 20);
+  state.SetLabel(cached ? "cache shared per time" : "no sharing (distinct t)");
+}
+
+// Rows: {N, D, L, solver (0 dense, 1 sparse, 2 iterative), segment seconds}.
+void QuickIterationRows(benchmark::internal::Benchmark* b) {
+  // N scaling at the config settings (D = 24, windows 50 s / 15 s, L = N/50).
+  b->Args({1000, 24, 20, 0, 50})->Args({1000, 24, 20, 1, 50});
+  b->Args({1000, 24, 20, 2, 50});
+  b->Args({10000, 24, 200, 0, 50})->Args({10000, 24, 200, 1, 50});
+  b->Args({10000, 24, 200, 2, 50});
+  b->Args({100000, 24, 2000, 1, 50})->Args({100000, 24, 2000, 2, 50});
+  // D sweep with one global feature map (100 s run).
+  for (int d : {20, 100, 400}) b->Args({1000, d, 20, 0, 0});
+  // D sweep with windows at N = 1e4.
+  for (int d : {50, 100}) b->Args({10000, d, 200, 1, 50});
+  // Landmark sweep at N = 1e4 (fewer landmarks: longer tracks, wider band).
+  for (int l : {50, 1000}) b->Args({10000, 24, l, 1, 50});
+}
+
+void LargeIterationRows(benchmark::internal::Benchmark* b) {
+  b->Args({1000000, 24, 20000, 1, 50})->Args({1000000, 24, 20000, 2, 50});
+}
+
+void Configure(benchmark::internal::Benchmark* b) {
+  b->ArgNames({"N", "D", "L", "solver", "seg"})
+      ->UseRealTime()
+      ->Unit(benchmark::kMillisecond);
+}
+
+}  // namespace
+}  // namespace rff
+
+int main(int argc, char** argv) {
+  bool large = false;
+  std::vector<char*> args;
+  for (int i = 0; i < argc; ++i) {
+    if (std::strcmp(argv[i], "--large") == 0) {
+      large = true;
+    } else if (std::strncmp(argv[i], "--threads=", 10) == 0) {
+      rff::g_threads = std::atoi(argv[i] + 10);
+    } else if (std::strncmp(argv[i], "--lm_iterations=", 16) == 0) {
+      rff::g_lm_iterations = std::max(2, std::atoi(argv[i] + 16));
+    } else {
+      args.push_back(argv[i]);
+    }
+  }
+  using benchmark::RegisterBenchmark;
+  // Registration order is run order: small to large, so the process-wide
+  // peak RSS of the last rows is theirs.
+  RegisterBenchmark("BM_GramLowerBound", rff::BM_GramLowerBound)
+      ->ArgNames({"rows", "D"})
+      ->ArgsProduct({{1000, 10000}, {24, 100, 400}})
+      ->UseRealTime()
+      ->Unit(benchmark::kMillisecond);
+  RegisterBenchmark("BM_FeatureCache", rff::BM_FeatureCache)
+      ->ArgNames({"N", "D", "cached"})
+      ->ArgsProduct({{10000, 100000}, {24, 100}, {1, 0}})
+      ->UseRealTime()
+      ->Unit(benchmark::kMillisecond);
+  rff::Configure(RegisterBenchmark("BM_Iteration", rff::BM_Iteration)
+                     ->Apply(rff::QuickIterationRows));
+  RegisterBenchmark("BM_FullSolve", rff::BM_FullSolve)
+      ->ArgName("N")
+      ->Arg(12500)
+      ->Arg(100000)
+      ->UseRealTime()
+      ->Unit(benchmark::kMillisecond)
+      ->Iterations(1);
+  if (large) {
+    rff::Configure(RegisterBenchmark("BM_Iteration", rff::BM_Iteration)
+                       ->Apply(rff::LargeIterationRows));
+  }
+  int count = static_cast<int>(args.size());
+  benchmark::Initialize(&count, args.data());
+  if (benchmark::ReportUnrecognizedArguments(count, args.data())) return 1;
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}
