@@ -3,7 +3,7 @@
 //   rff_experiment --out_dir=DIR [--quick] [--methods=rff,wnoa]
 //                  [--experiments=table1,figure1,table2,figure2,solvers]
 //                  [--configs_dir=configs] [--data_dir=data]
-//                  [--shared_dir=../shared] [--num_threads=2]
+//                  [--shared_dir=../shared] [--num_threads=1]
 //
 // Runs every method on every dataset of the selected experiments and writes
 // CSV and Markdown tables and SVG plots into DIR (see

@@ -95,7 +95,10 @@ DEFINE_string(preconditioner, "auto",
               "auto picks SCHUR_JACOBI, or JACOBI for CGNR.");
 DEFINE_string(trust_region_strategy, "LEVENBERG_MARQUARDT",
               "LEVENBERG_MARQUARDT or DOGLEG.");
-DEFINE_int32(num_threads, 2, "Threads for Jacobians and linear algebra.");
+DEFINE_int32(num_threads, 1,
+             "Threads for Jacobians and linear algebra. With 1 the outputs "
+             "are byte-identical from run to run; with more, Ceres sums in "
+             "thread-scheduling order and results differ in the last bits.");
 DEFINE_int32(max_iterations, 100, "Maximum number of solver iterations.");
 DEFINE_double(function_tolerance, 1e-8, "Ceres function tolerance.");
 DEFINE_double(gradient_tolerance, 1e-10, "Ceres gradient tolerance.");

@@ -135,6 +135,7 @@ std::map<LandmarkId, Eigen::Vector2d> SlamProblem::landmarks() const {
 }
 
 void SlamProblem::AddLandmarkPrior(const LandmarkPrior& p) {
+  has_prior_.insert(p.id);
   Remember(problem_->AddResidualBlock(
                new LandmarkPriorCost(Eigen::Vector2d(p.x, p.y), p.sigma),
                nullptr, landmark_block(p.id)),
@@ -258,6 +259,9 @@ bool SlamProblem::CheckLandmarksDetermined(double max_condition,
   std::vector<std::vector<double>> jacobians;
   std::vector<double*> jacobian_pointers;
   for (const LandmarkId id : added_) {
+    // A prior bounds the information from below in every direction; a huge
+    // eigenvalue beside it only says that a bearing sees it from close by.
+    if (has_prior_.count(id) > 0) continue;
     const double* position = landmark_block(id);
     // Information of the landmark given the trajectory: sum of J_l^T J_l.
     Eigen::Matrix2d information = Eigen::Matrix2d::Zero();

@@ -100,9 +100,10 @@ class SlamProblem {
   // Numerical guards. FindNonFinite evaluates every residual block at the
   // current values and describes the first whose residual or Jacobian is
   // not finite (false if there is none). CheckLandmarksDetermined fails,
-  // naming the landmark, when a landmark's information from its own
-  // residuals (without robust weights) is singular or ill-conditioned
-  // (condition number above `max_condition`): its estimate would be noise.
+  // naming the landmark, when the information of a landmark without a prior
+  // from its own residuals (without robust weights) is singular or
+  // ill-conditioned (condition number above `max_condition`): its estimate
+  // would be noise.
   bool FindNonFinite(std::string* description);
   bool CheckLandmarksDetermined(double max_condition, std::string* error);
 
@@ -141,6 +142,7 @@ class SlamProblem {
   std::map<LandmarkId, int> slots_;
   std::vector<Eigen::Vector2d> storage_;
   std::set<LandmarkId> added_;
+  std::set<LandmarkId> has_prior_;
   Eigen::Vector2d range_calibration_ = Eigen::Vector2d(1.0, 0.0);
 };
 

@@ -24,7 +24,8 @@ struct SolverOptions {
   std::string linear_solver = "DENSE_SCHUR";
   std::string preconditioner = "auto";  // Or a Ceres preconditioner name.
   std::string trust_region_strategy = "LEVENBERG_MARQUARDT";
-  int num_threads = 2;
+  // 1: reproducible to the bit; more threads sum in scheduling order.
+  int num_threads = 1;
   int max_iterations = 100;
   double function_tolerance = 1e-8;
   double gradient_tolerance = 1e-10;
