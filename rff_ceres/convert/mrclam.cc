@@ -163,12 +163,26 @@ bool ReadMeasurements(const std::string& path, MrclamRaw* raw,
       error);
 }
 
+// More pose times than this is a hostile input (or a wrong interval), not
+// a trajectory: 1e7 poses already need gigabytes in the solver.
+constexpr double kMaxTrajectoryTimes = 1e7;
+
 // The pose times: the distinct measurement times, with each gap longer
 // than `interval` (when > 0) split into equal steps rounded to the
-// millisecond.
-std::vector<double> TrajectoryTimes(const std::vector<double>& sorted_times,
-                                    double interval) {
-  std::vector<double> times;
+// millisecond. Fails when that gives more than kMaxTrajectoryTimes.
+bool TrajectoryTimes(const std::vector<double>& sorted_times, double interval,
+                     std::vector<double>* out) {
+  std::vector<double>& times = *out;
+  times.clear();
+  if (interval > 0.0 && !sorted_times.empty()) {
+    // Counted in double first: the step count of one gap may overflow int.
+    double total = 1.0;
+    for (std::size_t i = 1; i < sorted_times.size(); ++i) {
+      const double gap = sorted_times[i] - sorted_times[i - 1];
+      total += std::max(1.0, std::ceil(gap / interval - 1e-9));
+      if (!(total <= kMaxTrajectoryTimes)) return false;
+    }
+  }
   for (const double t : sorted_times) {
     if (!times.empty() && t == times.back()) continue;
     if (!times.empty() && interval > 0.0) {
@@ -183,7 +197,7 @@ std::vector<double> TrajectoryTimes(const std::vector<double>& sorted_times,
     }
     times.push_back(t);
   }
-  return times;
+  return true;
 }
 
 // Integrates the piecewise-constant velocities of `rows` over [t0, t1],
@@ -352,8 +366,16 @@ bool ConvertMrclam(const std::string& directory, const MrclamOptions& options,
     return false;
   }
 
-  const std::vector<double> times =
-      TrajectoryTimes(measurement_times, options.odometry_interval);
+  std::vector<double> times;
+  if (!TrajectoryTimes(measurement_times, options.odometry_interval, &times)) {
+    *error = robot + "_Measurement.dat: mrclam_odometry_interval " +
+             FormatNumber(options.odometry_interval) +
+             " s over the measurement times from " +
+             FormatNumber(measurement_times.front()) + " to " +
+             FormatNumber(measurement_times.back()) + " gives more than " +
+             FormatNumber(kMaxTrajectoryTimes) + " poses";
+    return false;
+  }
   summary->trajectory_times = times.size();
   std::size_t row = 0;
   for (std::size_t k = 0; k + 1 < times.size(); ++k) {
@@ -363,6 +385,13 @@ bool ConvertMrclam(const std::string& directory, const MrclamOptions& options,
     double path_length;
     IntegrateBetween(raw.odometry, odom.t0, odom.t1, &row, &odom.dx, &odom.dy,
                      &odom.dtheta, &path_length);
+    if (!std::isfinite(odom.dx) || !std::isfinite(odom.dy) ||
+        !std::isfinite(odom.dtheta) || !std::isfinite(path_length)) {
+      *error = robot + "_Odometry.dat: the velocities integrate to a " +
+               "non-finite motion from " + FormatNumber(odom.t0) + " to " +
+               FormatNumber(odom.t1) + " s";
+      return false;
+    }
     odom.dtheta = WrapAngle(odom.dtheta);
     odom.sigma_x = odom.sigma_y =
         std::max(options.odometry_sigma_xy_floor,

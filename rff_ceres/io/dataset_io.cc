@@ -205,10 +205,12 @@ void ParseMetadata(const std::vector<std::string>& comments, Dataset* dataset) {
   for (const std::string& comment : comments) {
     const std::size_t colon = comment.find(':');
     if (colon == std::string::npos) continue;  // Prose, not metadata.
+    // CR too: a line ending in "\r\r\n" keeps one CR after the reader
+    // strips the last, and a value ending in CR would not survive a write.
     auto trim = [](std::string s) {
-      const auto begin = s.find_first_not_of(" \t");
+      const auto begin = s.find_first_not_of(" \t\r");
       if (begin == std::string::npos) return std::string();
-      const auto end = s.find_last_not_of(" \t");
+      const auto end = s.find_last_not_of(" \t\r");
       return s.substr(begin, end - begin + 1);
     };
     std::string key = trim(comment.substr(0, colon));

@@ -1,6 +1,7 @@
 #include "rff_ceres/io/landmarks_io.h"
 
 #include <algorithm>
+#include <cmath>
 #include <fstream>
 #include <set>
 
@@ -62,7 +63,14 @@ bool ParseLandmarks(std::istream* input, const std::string& source,
       l.sxx = v[2];
       l.sxy = v[3];
       l.syy = v[4];
-      if (l.sxx < 0.0 || l.syy < 0.0 || l.sxy * l.sxy > l.sxx * l.syy) {
+      // sxy^2 <= sxx syy; with the square roots when the products overflow
+      // (inf > inf would pass any sxy).
+      const double product = l.sxx * l.syy;
+      const bool correlated_too_much =
+          std::isinf(product) || std::isinf(l.sxy * l.sxy)
+              ? std::abs(l.sxy) > std::sqrt(l.sxx) * std::sqrt(l.syy)
+              : l.sxy * l.sxy > product;
+      if (l.sxx < 0.0 || l.syy < 0.0 || correlated_too_much) {
         *error = reader.Error("covariance is not positive semi-definite");
         return false;
       }

@@ -44,6 +44,10 @@ bool LineReader::Next(std::vector<std::string_view>* fields) {
     }
     ++line_number_;
     if (!line_.empty() && line_.back() == '\r') line_.pop_back();
+    // A UTF-8 byte order mark (written by some Windows editors) is not text.
+    if (line_number_ == 1 && line_.compare(0, 3, "\xEF\xBB\xBF") == 0) {
+      line_.erase(0, 3);
+    }
     if (line_.find('\0') != std::string::npos) {
       error_ = Error("NUL byte in line (binary file?)");
       return false;

@@ -1,5 +1,6 @@
 #include "rff_ceres/io/tum_io.h"
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 
@@ -39,9 +40,18 @@ bool ParseTum(std::istream* input, const std::string& source,
     }
     double v[8];
     if (!ParseFiniteDoubles(reader, fields, 0, 8, v, error)) return false;
-    const double qx = v[4], qy = v[5], qz = v[6], qw = v[7];
+    // Divide by the largest component first: the squares of components
+    // above ~1e154 overflow to inf and would give a NaN yaw.
+    const double scale = std::max(
+        {std::abs(v[4]), std::abs(v[5]), std::abs(v[6]), std::abs(v[7])});
+    if (!(scale > 0.0)) {
+      *error = reader.Error("quaternion has zero norm");
+      return false;
+    }
+    const double qx = v[4] / scale, qy = v[5] / scale, qz = v[6] / scale,
+                 qw = v[7] / scale;
     const double norm2 = qx * qx + qy * qy + qz * qz + qw * qw;
-    if (!(norm2 > 1e-12)) {
+    if (!(scale * scale * norm2 > 1e-12)) {
       *error = reader.Error("quaternion has zero norm");
       return false;
     }

@@ -1,0 +1,517 @@
+// Runs the built command-line tools (from RFF_BINARY_DIR) on hostile files
+// and flags: each error exits non-zero with a message that names the problem,
+// and leaves no output file (in particular none with NaN or inf). The
+// solver-level cases (degenerate but valid datasets) check that rff_slam
+// either solves them to a finite trajectory or fails cleanly.
+#include <sys/wait.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "gmock/gmock.h"
+#include "gtest/gtest.h"
+#include "rff_ceres/io/text_parser.h"
+#include "rff_ceres/io/tum_io.h"
+#include "test/test_files.h"
+
+namespace rff {
+namespace {
+
+using ::testing::HasSubstr;
+using testing::ReadFile;
+using testing::WriteFile;
+
+struct RunResult {
+  int exit_code = -1;  // 128 + signal when killed by a signal.
+  std::string output;  // stdout and stderr.
+};
+
+// Runs `command` through the shell with a time limit (a hang is a failure:
+// exit code 124).
+RunResult RunCommand(const std::string& command) {
+  RunResult result;
+  const std::string full = "timeout 300 " + command + " 2>&1";
+  FILE* pipe = popen(full.c_str(), "r");
+  if (pipe == nullptr) return result;
+  char buffer[4096];
+  std::size_t n;
+  while ((n = std::fread(buffer, 1, sizeof(buffer), pipe)) > 0) {
+    result.output.append(buffer, n);
+  }
+  const int status = pclose(pipe);
+  if (WIFEXITED(status)) {
+    result.exit_code = WEXITSTATUS(status);
+  } else if (WIFSIGNALED(status)) {
+    result.exit_code = 128 + WTERMSIG(status);
+  }
+  return result;
+}
+
+// Replaces {bin} (the build directory) and {dir} (the test's scratch
+// directory) in `pattern`.
+std::string Expand(std::string pattern, const std::string& dir) {
+  const std::pair<std::string, std::string> keys[] = {{"{bin}", RFF_BINARY_DIR},
+                                                      {"{dir}", dir}};
+  for (const auto& [key, value] : keys) {
+    for (std::size_t at = pattern.find(key); at != std::string::npos;
+         at = pattern.find(key, at + value.size())) {
+      pattern.replace(at, key.size(), value);
+    }
+  }
+  return pattern;
+}
+
+bool HasNonFiniteToken(const std::string& text) {
+  std::istringstream in(text);
+  std::string token;
+  while (in >> token) {
+    std::string lower;
+    for (const char c : token) lower += static_cast<char>(std::tolower(c));
+    if (lower.find("nan") != std::string::npos ||
+        lower.find("inf") != std::string::npos) {
+      return true;
+    }
+  }
+  return false;
+}
+
+// The robot drives along x at 1 m/s for 10 s; three landmarks with priors;
+// noise-free range-bearing every second and odometry between. Times start
+// at `t0` (0, or a Unix-epoch time).
+std::string ValidDataset(double t0) {
+  auto n = [](double v) { return FormatNumber(v); };
+  std::ostringstream out;
+  out << "# source: app_errors_test\nRFFD 1\n"
+      << "PRIOR_POSE " << n(t0) << " 0 0 0 0.1 0.01\n";
+  const double landmarks[3][2] = {{5, 5}, {5, -5}, {10, 3}};
+  for (int i = 0; i < 3; ++i) {
+    out << "PRIOR_LANDMARK " << i + 1 << " " << landmarks[i][0] << " "
+        << landmarks[i][1] << " 1\n";
+    out << "GT_LANDMARK " << i + 1 << " " << landmarks[i][0] << " "
+        << landmarks[i][1] << "\n";
+  }
+  for (int k = 0; k <= 10; ++k) {
+    const double t = t0 + k;
+    if (k < 10) {
+      out << "ODOM " << n(t) << " " << n(t + 1) << " 1 0 0 0.05 0.05 0.01\n";
+    }
+    for (int i = 0; i < 3; ++i) {
+      const double dx = landmarks[i][0] - k, dy = landmarks[i][1];
+      out << "RANGE_BEARING " << n(t) << " " << i + 1 << " "
+          << n(std::hypot(dx, dy)) << " " << n(std::atan2(dy, dx))
+          << " 0.1 0.02\n";
+    }
+    out << "GT_POSE " << n(t) << " " << k << " 0 0\n";
+  }
+  return out.str();
+}
+
+// ---------------------------------------------------------------------------
+// Errors: one command per case. {dir}/valid.rffd holds ValidDataset(0),
+// {dir}/bad.rffd a dataset with a bad line 3, {dir}/single.rffd a single
+// PRIOR_POSE and {dir}/gt.tum a two-pose trajectory.
+struct AppCase {
+  const char* name;
+  const char* command;
+  const char* message;  // Expected part of the output.
+  const char* output;   // The file that must not be written ("" for none).
+};
+// Test names in ctest say the case, not the bytes of the struct.
+void PrintTo(const AppCase& c, std::ostream* out) { *out << c.name; }
+
+class AppErrorTest : public ::testing::TestWithParam<AppCase> {};
+
+TEST_P(AppErrorTest, ExitsNonZeroWithMessageAndNoOutput) {
+  const std::string dir = testing::TempDir("app_errors_test");
+  WriteFile(dir + "/valid.rffd", ValidDataset(0.0));
+  WriteFile(dir + "/bad.rffd", "RFFD 1\nPRIOR_POSE 0 0 0 0 1 1\nRANGE 1 2 3\n");
+  WriteFile(dir + "/gt.tum", "0 0 0 0 0 0 0 1\n1 1 0 0 0 0 0 1\n");
+  WriteFile(dir + "/single.rffd", "RFFD 1\nPRIOR_POSE 0 0 0 0 1 1\n");
+  const RunResult run = RunCommand(Expand(GetParam().command, dir));
+  EXPECT_EQ(run.exit_code, 1) << run.output;
+  EXPECT_THAT(run.output, HasSubstr(Expand(GetParam().message, dir)));
+  const std::string output = Expand(GetParam().output, dir);
+  if (!output.empty()) {
+    EXPECT_FALSE(std::filesystem::exists(output)) << output << ":\n"
+                                                  << ReadFile(output);
+  }
+}
+
+#define SLAM "{bin}/rff_slam --dataset={dir}/valid.rffd "
+#define SLAM_OUT " --output_trajectory={dir}/out.tum"
+
+const AppCase kAppCases[] = {
+    // rff_slam: files.
+    {"SlamNoDataset", "{bin}/rff_slam" SLAM_OUT,
+     "rff_slam: error: --dataset is required", "{dir}/out.tum"},
+    {"SlamMissingFile", "{bin}/rff_slam --dataset={dir}/none.rffd" SLAM_OUT,
+     "rff_slam: error: {dir}/none.rffd: cannot open for reading",
+     "{dir}/out.tum"},
+    {"SlamBadLine", "{bin}/rff_slam --dataset={dir}/bad.rffd" SLAM_OUT,
+     "rff_slam: error: {dir}/bad.rffd:3: RANGE needs 4 fields, got 3",
+     "{dir}/out.tum"},
+    {"SlamDirectoryAsDataset", "{bin}/rff_slam --dataset={dir}" SLAM_OUT,
+     "rff_slam: error: {dir}", "{dir}/out.tum"},
+    {"SlamUnexpectedArgument", SLAM "extra" SLAM_OUT,
+     "rff_slam: error: unexpected argument 'extra'", "{dir}/out.tum"},
+    {"SlamUnwritableOutput",
+     SLAM "--output_trajectory={dir}/no/such/dir/out.tum",
+     "{dir}/no/such/dir/out.tum: cannot open for writing", ""},
+    // rff_slam: flags (gflags itself rejects unknown and malformed ones).
+    {"SlamUnknownFlag", SLAM "--no_such_flag=1" SLAM_OUT,
+     "unknown command line flag 'no_such_flag'", "{dir}/out.tum"},
+    {"SlamMalformedInteger", SLAM "--num_features=abc" SLAM_OUT,
+     "illegal value 'abc' specified for int32 flag 'num_features'",
+     "{dir}/out.tum"},
+    {"SlamNegativeD", SLAM "--num_features=-5" SLAM_OUT,
+     "hilbert: num_features must be in [1, ", "{dir}/out.tum"},
+    {"SlamZeroD", SLAM "--num_features=0" SLAM_OUT,
+     "hilbert: num_features must be in [1, ", "{dir}/out.tum"},
+    {"SlamUnknownKernel", SLAM "--kernel=gaussian" SLAM_OUT,
+     "unknown kernel 'gaussian'", "{dir}/out.tum"},
+    {"SlamUnknownHeadingKernel", SLAM "--heading_kernel=bogus" SLAM_OUT,
+     "unknown kernel 'bogus'", "{dir}/out.tum"},
+    {"SlamZeroLengthscale", SLAM "--lengthscale=0" SLAM_OUT,
+     "kernel lengthscale must be positive and finite, got 0", "{dir}/out.tum"},
+    {"SlamNaNLengthscale", SLAM "--lengthscale=nan" SLAM_OUT,
+     "kernel lengthscale must be positive and finite, got nan",
+     "{dir}/out.tum"},
+    {"SlamNegativeVariance", SLAM "--kernel_variance=-1" SLAM_OUT,
+     "kernel variance must be positive and finite, got -1", "{dir}/out.tum"},
+    {"SlamZeroThreads", SLAM "--num_threads=0" SLAM_OUT,
+     "num_threads must be >= 1", "{dir}/out.tum"},
+    {"SlamZeroIterations", SLAM "--max_iterations=0" SLAM_OUT,
+     "max_iterations must be >= 1", "{dir}/out.tum"},
+    {"SlamNegativeTolerance", SLAM "--function_tolerance=-1" SLAM_OUT,
+     "solver tolerances must be finite and >= 0", "{dir}/out.tum"},
+    {"SlamUnknownLinearSolver", SLAM "--linear_solver=MAGIC" SLAM_OUT,
+     "unknown linear solver 'MAGIC'", "{dir}/out.tum"},
+    {"SlamUnknownPreconditioner",
+     SLAM "--linear_solver=ITERATIVE_SCHUR --preconditioner=MAGIC" SLAM_OUT,
+     "unknown preconditioner 'MAGIC'", "{dir}/out.tum"},
+    {"SlamCgnrWithSchurPreconditioner",
+     SLAM "--linear_solver=CGNR --preconditioner=SCHUR_JACOBI" SLAM_OUT,
+     "linear solver CGNR supports the preconditioners IDENTITY and JACOBI",
+     "{dir}/out.tum"},
+    {"SlamUnknownTrustRegion", SLAM "--trust_region_strategy=MAGIC" SLAM_OUT,
+     "unknown trust region strategy 'MAGIC'", "{dir}/out.tum"},
+    {"SlamOverlapEqualsLength",
+     SLAM "--segment_length=5 --segment_overlap=5" SLAM_OUT,
+     "segment length and overlap must be >= 0, with overlap < length",
+     "{dir}/out.tum"},
+    {"SlamOverlapExceedsLength",
+     SLAM "--segment_length=2 --segment_overlap=3" SLAM_OUT,
+     "segment length and overlap must be >= 0, with overlap < length",
+     "{dir}/out.tum"},
+    {"SlamNegativeSegmentLength", SLAM "--segment_length=-1" SLAM_OUT,
+     "segment length and overlap must be >= 0", "{dir}/out.tum"},
+    {"SlamUnknownFeatures", SLAM "--features=wavelets" SLAM_OUT,
+     "unknown feature family 'wavelets'", "{dir}/out.tum"},
+    {"SlamUnknownLoss", SLAM "--loss=tukey" SLAM_OUT,
+     "unknown loss 'tukey' (expected none, huber or cauchy)", "{dir}/out.tum"},
+    {"SlamZeroLossScale", SLAM "--loss=huber --loss_scale=0" SLAM_OUT,
+     "loss scale must be a positive number, got 0", "{dir}/out.tum"},
+    {"SlamUnknownPriorMean", SLAM "--prior_mean=psychic" SLAM_OUT,
+     "unknown prior mean 'psychic'", "{dir}/out.tum"},
+    {"SlamNegativeOuterRounds", SLAM "--outer_rounds=-1" SLAM_OUT,
+     "outer_rounds must be >= 0, got -1", "{dir}/out.tum"},
+    {"SlamSplineSmoothingAboveOne", SLAM "--spline_smoothing=2" SLAM_OUT,
+     "spline_smoothing must be in [0, 1], got 2", "{dir}/out.tum"},
+    // rff_convert.
+    {"ConvertUnknownFormat",
+     "{bin}/rff_convert --format=kitti --input={dir} --output={dir}/o.rffd",
+     "rff_convert: --format must be plaza or mrclam, got 'kitti'",
+     "{dir}/o.rffd"},
+    {"ConvertNoInput", "{bin}/rff_convert --format=plaza --output={dir}/o.rffd",
+     "rff_convert: --input=DIR is required", "{dir}/o.rffd"},
+    {"ConvertNoOutput", "{bin}/rff_convert --format=plaza --input={dir}",
+     "rff_convert: --output=OUT.rffd is required", ""},
+    {"ConvertMissingRawFiles",
+     "{bin}/rff_convert --format=plaza --input={dir}/none "
+     "--output={dir}/o.rffd",
+     "rff_convert: {dir}/none/Plaza1_GT.txt: cannot open for reading",
+     "{dir}/o.rffd"},
+    {"ConvertUnknownCalibration",
+     "{bin}/rff_convert --format=plaza --input={dir} --output={dir}/o.rffd "
+     "--plaza_calibration=cubic",
+     "unknown Plaza calibration 'cubic' (use linear or none)", "{dir}/o.rffd"},
+    {"ConvertMrclamWithoutRobot",
+     "{bin}/rff_convert --format=mrclam --input={dir} --output={dir}/o.rffd",
+     "rff_convert: mrclam_robot must be 1..5, got 0", "{dir}/o.rffd"},
+    {"ConvertNegativeGtRate",
+     "{bin}/rff_convert --format=mrclam --mrclam_robot=1 --input={dir} "
+     "--output={dir}/o.rffd --gt_rate_hz=-1",
+     "rff_convert: gt_rate_hz must be >= 0, got -1", "{dir}/o.rffd"},
+    {"ConvertNaNSigma",
+     "{bin}/rff_convert --format=plaza --input={dir} --output={dir}/o.rffd "
+     "--plaza_odom_sigma_xy_floor=nan",
+     "plaza_odom_sigma_xy_floor must be > 0, got nan", "{dir}/o.rffd"},
+    // rff_simulate.
+    {"SimulateNoOutput", "{bin}/rff_simulate",
+     "rff_simulate: error: --output is required", ""},
+    {"SimulateUnknownPreset",
+     "{bin}/rff_simulate --output={dir}/s.rffd --preset=huge",
+     "rff_simulate: error: unknown --preset 'huge'", "{dir}/s.rffd"},
+    {"SimulateUnknownKind",
+     "{bin}/rff_simulate --output={dir}/s.rffd --kind=sonar",
+     "rff_simulate: error: --kind: unknown measurement kind 'sonar'",
+     "{dir}/s.rffd"},
+    {"SimulateZeroSteps",
+     "{bin}/rff_simulate --output={dir}/s.rffd --num_steps=0",
+     "num_steps must be in [1, ", "{dir}/s.rffd"},
+    {"SimulateNegativeLandmarks",
+     "{bin}/rff_simulate --output={dir}/s.rffd --landmarks=-3",
+     "landmarks must be in [1, ", "{dir}/s.rffd"},
+    {"SimulateZeroTimeStep", "{bin}/rff_simulate --output={dir}/s.rffd --dt=0",
+     "dt must be finite and > 0", "{dir}/s.rffd"},
+    {"SimulateNaNRangeSigma",
+     "{bin}/rff_simulate --output={dir}/s.rffd --sigma_range=nan",
+     "sigma_range must be finite and > 0", "{dir}/s.rffd"},
+    {"SimulateNaNBearingSigma",
+     "{bin}/rff_simulate --output={dir}/s.rffd --sigma_bearing_deg=nan",
+     "--sigma_bearing_deg must be finite and > 0, got nan", "{dir}/s.rffd"},
+    {"SimulateZeroFieldOfView",
+     "{bin}/rff_simulate --output={dir}/s.rffd --field_of_view_deg=0",
+     "--field_of_view_deg must be in (0, 360], got 0", "{dir}/s.rffd"},
+    // rff_evaluate.
+    {"EvaluateNoTrajectory", "{bin}/rff_evaluate --dataset={dir}/valid.rffd",
+     "rff_evaluate: error: --trajectory is required", ""},
+    {"EvaluateDatasetWithoutTruth",
+     "{bin}/rff_evaluate --dataset={dir}/bad.rffd --trajectory={dir}/gt.tum",
+     "rff_evaluate: error: {dir}/bad.rffd:3:", ""},
+    {"EvaluateBadTrajectory",
+     "{bin}/rff_evaluate --dataset={dir}/valid.rffd "
+     "--trajectory={dir}/valid.rffd --json={dir}/e.json",
+     "rff_evaluate: error: {dir}/valid.rffd:2: a TUM pose needs 8 fields",
+     "{dir}/e.json"},
+    {"EvaluateBadLandmarks",
+     "{bin}/rff_evaluate --dataset={dir}/valid.rffd --trajectory={dir}/gt.tum "
+     "--landmarks={dir}/gt.tum --json={dir}/e.json",
+     "rff_evaluate: error: {dir}/gt.tum:1: a landmark needs 3 fields",
+     "{dir}/e.json"},
+    // rff_dead_reckoning.
+    {"DeadReckoningNoOutput",
+     "{bin}/rff_dead_reckoning --dataset={dir}/valid.rffd",
+     "rff_dead_reckoning: error: --output_trajectory is required", ""},
+    {"DeadReckoningBadLine",
+     "{bin}/rff_dead_reckoning --dataset={dir}/bad.rffd "
+     "--output_trajectory={dir}/dr.tum",
+     "rff_dead_reckoning: error: {dir}/bad.rffd:3: RANGE needs 4 fields",
+     "{dir}/dr.tum"},
+    {"DeadReckoningMalformedBool",
+     "{bin}/rff_dead_reckoning --dataset={dir}/valid.rffd "
+     "--output_trajectory={dir}/dr.tum --hold_through_gaps=maybe",
+     "illegal value 'maybe' specified for bool flag 'hold_through_gaps'",
+     "{dir}/dr.tum"},
+    {"DeadReckoningWithoutOdometry",
+     "{bin}/rff_dead_reckoning --dataset={dir}/single.rffd "
+     "--output_trajectory={dir}/dr.tum",
+     "rff_dead_reckoning: error: {dir}/single.rffd: the dataset has no "
+     "ODOM records",
+     "{dir}/dr.tum"},
+};
+
+INSTANTIATE_TEST_SUITE_P(Cases, AppErrorTest, ::testing::ValuesIn(kAppCases),
+                         [](const ::testing::TestParamInfo<AppCase>& info) {
+                           return std::string(info.param.name);
+                         });
+
+// ---------------------------------------------------------------------------
+// Hostile files through the apps, where the case needs more than one file.
+
+TEST(AppHostileFileTest, ConvertRawFileErrorNamesFileAndLineAndWritesNothing) {
+  const std::string dir = testing::TempDir("app_errors_test");
+  WriteFile(dir + "/Tiny_GT.txt", "0 0 0 0\r\n1 1 0 nan\r\n");
+  const RunResult run =
+      RunCommand(Expand("{bin}/rff_convert --format=plaza --plaza_name=Tiny "
+                        "--input={dir} --output={dir}/o.rffd",
+                        dir));
+  EXPECT_EQ(run.exit_code, 1) << run.output;
+  EXPECT_THAT(run.output,
+              HasSubstr(dir + "/Tiny_GT.txt:2: field 4 'nan' is not a finite"));
+  EXPECT_FALSE(std::filesystem::exists(dir + "/o.rffd"));
+}
+
+TEST(AppHostileFileTest, EvaluateTrajectoryWithNaNIsRefused) {
+  const std::string dir = testing::TempDir("app_errors_test");
+  WriteFile(dir + "/valid.rffd", ValidDataset(0.0));
+  WriteFile(dir + "/est.tum", "0 0 0 0 0 0 0 1\n1 nan 0 0 0 0 0 1\n");
+  const RunResult run =
+      RunCommand(Expand("{bin}/rff_evaluate --dataset={dir}/valid.rffd "
+                        "--trajectory={dir}/est.tum",
+                        dir));
+  EXPECT_EQ(run.exit_code, 1) << run.output;
+  EXPECT_THAT(run.output,
+              HasSubstr(dir + "/est.tum:2: field 2 'nan' is not a finite"));
+}
+
+TEST(AppHostileFileTest, BinaryJunkDatasetIsRefused) {
+  const std::string dir = testing::TempDir("app_errors_test");
+  WriteFile(dir + "/junk.rffd", std::string("\x7f"
+                                            "ELF\x02\x01\x01\x00\x00",
+                                            9));
+  const RunResult run =
+      RunCommand(Expand("{bin}/rff_slam --dataset={dir}/junk.rffd "
+                        "--output_trajectory={dir}/o.tum",
+                        dir));
+  EXPECT_EQ(run.exit_code, 1) << run.output;
+  EXPECT_THAT(run.output, HasSubstr(dir + "/junk.rffd:1: NUL byte in line"));
+  EXPECT_FALSE(std::filesystem::exists(dir + "/o.tum"));
+}
+
+TEST(AppHostileFileTest, EmptyDatasetIsRefused) {
+  const std::string dir = testing::TempDir("app_errors_test");
+  WriteFile(dir + "/empty.rffd", "");
+  const RunResult run =
+      RunCommand(Expand("{bin}/rff_dead_reckoning --dataset={dir}/empty.rffd "
+                        "--output_trajectory={dir}/o.tum",
+                        dir));
+  EXPECT_EQ(run.exit_code, 1) << run.output;
+  EXPECT_THAT(run.output, HasSubstr(dir + "/empty.rffd: missing header"));
+  EXPECT_FALSE(std::filesystem::exists(dir + "/o.tum"));
+}
+
+// FORMAT.md allows CRLF: the same dataset with CRLF line ends solves.
+TEST(AppHostileFileTest, CrlfDatasetSolves) {
+  const std::string dir = testing::TempDir("app_errors_test");
+  std::string crlf;
+  for (const char c : ValidDataset(0.0)) {
+    crlf += c == '\n' ? std::string("\r\n") : std::string(1, c);
+  }
+  WriteFile(dir + "/crlf.rffd", crlf);
+  const RunResult run =
+      RunCommand(Expand("{bin}/rff_slam --dataset={dir}/crlf.rffd "
+                        "--output_trajectory={dir}/o.tum",
+                        dir));
+  EXPECT_EQ(run.exit_code, 0) << run.output;
+  std::vector<TimedPose> poses;
+  std::string error;
+  ASSERT_TRUE(ReadTum(dir + "/o.tum", &poses, &error)) << error;
+  EXPECT_EQ(poses.size(), 11u);
+}
+
+// ---------------------------------------------------------------------------
+// Solver-level: well-formed but degenerate datasets. rff_slam either solves
+// them (exit 0, a finite trajectory at the expected times) or fails with
+// "rff_slam: error: DATASET: ..." and exit 1; never a crash, a hang or NaN.
+struct SolveOutcome {
+  RunResult run;
+  std::string trajectory;  // The TUM file, "" when not written.
+};
+
+SolveOutcome Solve(const std::string& dir, const std::string& dataset_text,
+                   const std::string& flags = "") {
+  WriteFile(dir + "/in.rffd", dataset_text);
+  SolveOutcome outcome;
+  outcome.run =
+      RunCommand(Expand("{bin}/rff_slam --dataset={dir}/in.rffd "
+                        "--output_trajectory={dir}/out.tum "
+                        "--output_landmarks={dir}/out.landmarks " +
+                            flags,
+                        dir));
+  if (std::filesystem::exists(dir + "/out.tum")) {
+    outcome.trajectory = ReadFile(dir + "/out.tum");
+  }
+  return outcome;
+}
+
+// Checks the contract; returns true when the case solved.
+bool SolvedOrFailedCleanly(const std::string& dir, const SolveOutcome& o) {
+  EXPECT_TRUE(o.run.exit_code == 0 || o.run.exit_code == 1)
+      << "exit " << o.run.exit_code << "\n"
+      << o.run.output;
+  EXPECT_FALSE(HasNonFiniteToken(o.trajectory)) << o.trajectory;
+  if (std::filesystem::exists(dir + "/out.landmarks")) {
+    EXPECT_FALSE(HasNonFiniteToken(ReadFile(dir + "/out.landmarks")));
+  }
+  if (o.run.exit_code == 1) {
+    EXPECT_THAT(o.run.output,
+                HasSubstr("rff_slam: error: " + dir + "/in.rffd: "));
+  }
+  return o.run.exit_code == 0;
+}
+
+TEST(SolverHostileTest, DatasetWithoutObservationsFollowsOdometry) {
+  const std::string dir = testing::TempDir("app_errors_test");
+  const SolveOutcome o =
+      Solve(dir,
+            "RFFD 1\nPRIOR_POSE 0 0 0 0 0.1 0.01\n"
+            "ODOM 0 1 1 0 0 0.05 0.05 0.01\nODOM 1 2 1 0 0 0.05 0.05 0.01\n");
+  if (!SolvedOrFailedCleanly(dir, o)) return;
+  std::vector<TimedPose> poses;
+  std::string error;
+  ASSERT_TRUE(ReadTum(dir + "/out.tum", &poses, &error)) << error;
+  ASSERT_EQ(poses.size(), 3u);  // The ODOM times 0, 1, 2.
+  EXPECT_NEAR(poses[2].x, 2.0, 0.05);
+}
+
+TEST(SolverHostileTest, SinglePose) {
+  const std::string dir = testing::TempDir("app_errors_test");
+  const SolveOutcome o = Solve(dir, "RFFD 1\nPRIOR_POSE 3 1 2 0.5 0.1 0.01\n");
+  if (!SolvedOrFailedCleanly(dir, o)) return;
+  std::vector<TimedPose> poses;
+  std::string error;
+  ASSERT_TRUE(ReadTum(dir + "/out.tum", &poses, &error)) << error;
+  ASSERT_EQ(poses.size(), 1u);
+  EXPECT_NEAR(poses[0].x, 1.0, 1e-3);
+  EXPECT_NEAR(poses[0].y, 2.0, 1e-3);
+}
+
+TEST(SolverHostileTest, AllObservationsAtOneTime) {
+  const std::string dir = testing::TempDir("app_errors_test");
+  const SolveOutcome o =
+      Solve(dir,
+            "RFFD 1\nPRIOR_POSE 0 0 0 0 0.1 0.01\n"
+            "PRIOR_LANDMARK 1 5 0 1\nPRIOR_LANDMARK 2 0 5 1\n"
+            "RANGE_BEARING 0 1 5 0 0.1 0.02\n"
+            "RANGE_BEARING 0 2 5 1.5707963267948966 0.1 0.02\n");
+  if (!SolvedOrFailedCleanly(dir, o)) return;
+  std::vector<TimedPose> poses;
+  std::string error;
+  ASSERT_TRUE(ReadTum(dir + "/out.tum", &poses, &error)) << error;
+  ASSERT_EQ(poses.size(), 1u);
+  EXPECT_NEAR(poses[0].x, 0.0, 0.05);
+}
+
+// One range to a landmark without a prior does not locate it: a clear error
+// naming the landmark (landmark_init), exit 1, no output.
+TEST(SolverHostileTest, SingleRangeToUnconstrainedLandmarkIsAnError) {
+  const std::string dir = testing::TempDir("app_errors_test");
+  const SolveOutcome o =
+      Solve(dir,
+            "RFFD 1\nPRIOR_POSE 0 0 0 0 0.1 0.01\n"
+            "ODOM 0 1 1 0 0 0.05 0.05 0.01\nRANGE 1 9 4 0.1\n");
+  EXPECT_EQ(o.run.exit_code, 1) << o.run.output;
+  EXPECT_THAT(o.run.output, HasSubstr("rff_slam: error: " + dir +
+                                      "/in.rffd: landmark 9 has no "
+                                      "PRIOR_LANDMARK"));
+  EXPECT_TRUE(o.trajectory.empty());
+}
+
+// Unix-epoch times (1.2e9 s) solve like the same run started at 0.
+TEST(SolverHostileTest, UnixEpochTimesSolveLikeZeroOrigin) {
+  const std::string dir = testing::TempDir("app_errors_test");
+  const SolveOutcome zero = Solve(dir, ValidDataset(0.0));
+  ASSERT_EQ(zero.run.exit_code, 0) << zero.run.output;
+  std::vector<TimedPose> a, b;
+  std::string error;
+  ASSERT_TRUE(ReadTum(dir + "/out.tum", &a, &error)) << error;
+  const SolveOutcome epoch = Solve(dir, ValidDataset(1.2e9));
+  ASSERT_EQ(epoch.run.exit_code, 0) << epoch.run.output;
+  ASSERT_TRUE(ReadTum(dir + "/out.tum", &b, &error)) << error;
+  ASSERT_EQ(a.size(), 11u);
+  ASSERT_EQ(b.size(), 11u);
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    EXPECT_EQ(b[i].t, 1.2e9 + static_cast<double>(i));
+    EXPECT_NEAR(b[i].x, a[i].x, 0.01) << i;
+    EXPECT_NEAR(b[i].y, a[i].y, 0.01) << i;
+    EXPECT_NEAR(b[i].x, static_cast<double>(i), 0.1) << i;
+  }
+}
+
+}  // namespace
+}  // namespace rff
