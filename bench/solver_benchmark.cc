@@ -36,6 +36,7 @@
 #include "rff_ceres/simulate.h"
 #include "rff_ceres/slam_problem.h"
 #include "rff_ceres/slam_solver.h"
+#include "test/synthetic_options.h"
 
 namespace rff {
 namespace {
@@ -153,15 +154,9 @@ bool MakeDataset(int num_observations, int num_landmarks, Dataset* dataset,
 // global feature map.
 SlamOptions BenchOptions(int num_features, double segment,
                          const std::string& solver) {
-  SlamOptions options;
-  options.prior_mean = "auto";  // Odometry: the dataset has ODOM.
+  // Odometry mean: the dataset has ODOM.
+  SlamOptions options = testing::SyntheticRangeBearingOptions();
   FeatureTrajectoryOptions& t = options.trajectory;
-  t.position_kernel.name = "rbf";
-  t.position_kernel.lengthscale = 5.0;
-  t.position_kernel.variance = 100.0;
-  t.heading_kernel = t.position_kernel;
-  t.heading_kernel.variance = 0.25;
-  t.family = "hilbert";
   t.num_position_features = num_features;
   t.num_heading_features = num_features;
   t.segment_length = segment;

@@ -11,7 +11,7 @@
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
 #include "rff_ceres/simulate.h"
-#include "test_files.h"
+#include "test/test_files.h"
 
 namespace rff {
 namespace {
@@ -36,15 +36,6 @@ std::vector<std::string> Cells(const std::string& line) {
   std::istringstream stream(line + ",");
   while (std::getline(stream, cell, ',')) cells.push_back(cell);
   return cells;
-}
-
-int Count(const std::string& text, const std::string& what) {
-  int count = 0;
-  for (std::size_t at = text.find(what); at != std::string::npos;
-       at = text.find(what, at + 1)) {
-    ++count;
-  }
-  return count;
 }
 
 TEST(ParseMethodsTest, BuiltInAndPatternMethods) {
@@ -351,8 +342,8 @@ TEST(GridTest, QuickAndFullGridSizes) {
   // Landmark sweep (3) + noise sweep without its x1 point (2), x 2 seeds.
   EXPECT_EQ(Figure1Datasets(true).size(), 3u * 5u * 2u);
   EXPECT_EQ(Figure1Datasets(false).size(), 3u * 8u * 10u);
-  EXPECT_EQ(SolverVariants(true).size(), 3u * 4u * 2u);
-  EXPECT_EQ(SolverVariants(false).size(), 3u * 4u * 3u);
+  EXPECT_EQ(SolverVariants(true).size(), 4u * 4u * 2u);
+  EXPECT_EQ(SolverVariants(false).size(), 4u * 4u * 3u);
   const std::vector<DatasetSpec> table2 =
       Table2Datasets(true, "data", "/no/such/shared");
   ASSERT_EQ(table2.size(), 5u);
@@ -456,7 +447,7 @@ TEST(RffExperimentAppTest, QuickPresetWritesEveryTableAndPlot) {
   EXPECT_THAT(noise, HasSubstr("</svg>"));
   EXPECT_THAT(noise, HasSubstr(">rff, range_bearing</text>"));
   EXPECT_THAT(noise, HasSubstr(">missing, bearing (all runs failed)</text>"));
-  EXPECT_EQ(Count(noise, "class=\"legend-entry\""), 6);
+  EXPECT_EQ(testing::CountOccurrences(noise, "class=\"legend-entry\""), 6);
   EXPECT_THAT(noise, HasSubstr(">observation noise [multiple of sigma_r = 1 "
                                "m, sigma_b = 2 deg]</text>"));
   EXPECT_THAT(noise, HasSubstr(">APE-trans RMS, median over seeds [m]</text>"));

@@ -16,6 +16,7 @@
 #include "rff_ceres/io/text_parser.h"
 #include "rff_ceres/simulate.h"
 #include "rff_ceres/slam_solver.h"
+#include "test/synthetic_options.h"
 
 namespace rff {
 namespace {
@@ -262,21 +263,7 @@ TEST(PosteriorCovarianceTest, MatchesTheDenseInverseWithWindowedWeights) {
 
 // configs/synthetic_range_bearing.flags as SlamOptions.
 SlamOptions SyntheticRangeBearingOptions(int outer_rounds) {
-  SlamOptions options;
-  options.prior_mean = "auto";
-  FeatureTrajectoryOptions& t = options.trajectory;
-  t.position_kernel.name = "rbf";
-  t.position_kernel.lengthscale = 5.0;
-  t.position_kernel.variance = 100.0;
-  t.heading_kernel = t.position_kernel;
-  t.heading_kernel.variance = 0.25;
-  t.family = "hilbert";
-  t.num_position_features = 24;
-  t.num_heading_features = 24;
-  t.segment_length = 50.0;
-  t.segment_overlap = 15.0;
-  options.solver.linear_solver = "DENSE_SCHUR";
-  options.solver.num_threads = 1;
+  SlamOptions options = testing::SyntheticRangeBearingOptions();
   options.outer_rounds = outer_rounds;
   options.compute_covariance = true;
   return options;

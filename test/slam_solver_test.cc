@@ -7,6 +7,7 @@
 #include "rff_ceres/mean/prior_mean.h"
 #include "rff_ceres/metrics.h"
 #include "rff_ceres/simulate.h"
+#include "test/synthetic_options.h"
 
 namespace rff {
 namespace {
@@ -15,21 +16,7 @@ using ::testing::HasSubstr;
 
 // Options that work on the paper's simulated protocol (300 s, 1 Hz).
 SlamOptions PaperSolverOptions() {
-  SlamOptions options;
-  FeatureTrajectoryOptions& t = options.trajectory;
-  t.position_kernel.name = "rbf";
-  t.position_kernel.lengthscale = 5.0;
-  t.position_kernel.variance = 100.0;
-  t.heading_kernel = t.position_kernel;
-  t.heading_kernel.variance = 0.25;
-  t.family = "hilbert";
-  t.num_position_features = 24;
-  t.num_heading_features = 24;
-  t.segment_length = 50.0;
-  t.segment_overlap = 15.0;
-  options.solver.linear_solver = "DENSE_SCHUR";
-  options.solver.num_threads = 1;
-  return options;
+  return testing::SyntheticRangeBearingOptions();
 }
 
 double ApeTranslation(const Dataset& dataset, const SlamResult& result) {

@@ -6,6 +6,7 @@
 
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
+#include "test/test_files.h"
 
 namespace rff {
 namespace {
@@ -14,15 +15,6 @@ using ::testing::ElementsAre;
 using ::testing::HasSubstr;
 using ::testing::Not;
 using ::testing::StartsWith;
-
-int Count(const std::string& text, const std::string& what) {
-  int count = 0;
-  for (std::size_t at = text.find(what); at != std::string::npos;
-       at = text.find(what, at + 1)) {
-    ++count;
-  }
-  return count;
-}
 
 TEST(NiceTicksTest, RangeZeroToSevenPointThreeStepsByTwo) {
   // (7.3 - 0) / 5 = 1.46 -> the next nice step is 2; the last tick covers 7.3.
@@ -172,15 +164,17 @@ TEST(RenderSvgTest, WellFormedWithEscapedTextAndOneLegendEntryPerLabel) {
   EXPECT_THAT(svg, Not(HasSubstr("errors <&>")));
   EXPECT_THAT(svg, HasSubstr(">time [s]</text>"));
   EXPECT_THAT(svg, HasSubstr(">error [m]</text>"));
-  EXPECT_EQ(Count(svg, "class=\"legend-entry\""), 2);
+  EXPECT_EQ(testing::CountOccurrences(svg, "class=\"legend-entry\""), 2);
   // The first series is one polyline of three points, the second two dots.
-  EXPECT_EQ(Count(svg, "<polyline"), 1);
+  EXPECT_EQ(testing::CountOccurrences(svg, "<polyline"), 1);
   EXPECT_THAT(svg, HasSubstr("points=\"70.00,430.00 310.00,235.00 "
                              "508.00,40.00\""));
-  EXPECT_EQ(Count(svg, "<circle"), 2 + 1);  // Two points + legend marker.
-  EXPECT_EQ(Count(svg, "class=\"x-tick\""), 5);
+  EXPECT_EQ(testing::CountOccurrences(svg, "<circle"),
+            2 + 1);  // Two points + legend marker.
+  EXPECT_EQ(testing::CountOccurrences(svg, "class=\"x-tick\""), 5);
   EXPECT_THAT(svg, HasSubstr(">8</text>"));
-  EXPECT_EQ(Count(svg, "<g"), Count(svg, "</g>"));
+  EXPECT_EQ(testing::CountOccurrences(svg, "<g"),
+            testing::CountOccurrences(svg, "</g>"));
 }
 
 TEST(RenderSvgTest, NonFiniteValuesBreakTheLine) {
@@ -193,7 +187,7 @@ TEST(RenderSvgTest, NonFiniteValuesBreakTheLine) {
   plot.series = {s};
   std::string svg, error;
   ASSERT_TRUE(RenderSvg(plot, &svg, &error)) << error;
-  EXPECT_EQ(Count(svg, "<polyline"), 2);
+  EXPECT_EQ(testing::CountOccurrences(svg, "<polyline"), 2);
   EXPECT_THAT(svg, Not(HasSubstr("nan")));
 }
 
@@ -206,8 +200,8 @@ TEST(RenderSvgTest, NoFinitePointDrawsEmptyAxesWithTheLegend) {
   plot.series = {s};
   std::string svg, error;
   ASSERT_TRUE(RenderSvg(plot, &svg, &error)) << error;
-  EXPECT_EQ(Count(svg, "class=\"legend-entry\""), 1);
-  EXPECT_EQ(Count(svg, "<polyline"), 0);
+  EXPECT_EQ(testing::CountOccurrences(svg, "class=\"legend-entry\""), 1);
+  EXPECT_EQ(testing::CountOccurrences(svg, "<polyline"), 0);
 }
 
 }  // namespace

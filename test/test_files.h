@@ -35,6 +35,16 @@ inline std::string ReadFile(const std::string& path) {
   return buffer.str();
 }
 
+// How many times `what` occurs in `text` (overlaps counted).
+inline int CountOccurrences(const std::string& text, const std::string& what) {
+  int count = 0;
+  for (std::size_t at = text.find(what); at != std::string::npos;
+       at = text.find(what, at + 1)) {
+    ++count;
+  }
+  return count;
+}
+
 }  // namespace testing
 }  // namespace rff
 
