@@ -43,7 +43,8 @@ TEST(LogTicksTest, PowersOfTenOrOneTwoFive) {
   EXPECT_THAT(LogTicks(0.5, 2000.0), ElementsAre(1, 10, 100, 1000));
   // Fewer than three powers inside: 1, 2, 5 per decade.
   EXPECT_THAT(LogTicks(4.0, 120.0), ElementsAre(5, 10, 20, 50, 100));
-  EXPECT_THAT(LogTicks(0.4, 4.6), ElementsAre(0.5, 1, 2));
+  EXPECT_THAT(LogTicks(0.4, 4.6), ElementsAre(0.5, 1, 2, 4));
+  EXPECT_THAT(LogTicks(0.5, 4.0), ElementsAre(0.5, 1, 2, 4));
 }
 
 TEST(TickLabelTest, DecimalsFollowTheStep) {

@@ -103,7 +103,13 @@ std::vector<double> LogTicks(double low, double high) {
     return ticks;
   };
   std::vector<double> ticks = collect({1.0});
-  if (ticks.size() < 3) ticks = collect({1.0, 2.0, 5.0});
+  if (ticks.size() < 3) {
+    ticks = collect({1.0, 2.0, 5.0});
+    // Doublings of the noise scale (x0.5 .. x4) end on a 4: label it.
+    if (!ticks.empty() && 2.0 * ticks.back() <= high * (1.0 + kTickSlack)) {
+      ticks.push_back(2.0 * ticks.back());
+    }
+  }
   return ticks;
 }
 
