@@ -430,17 +430,17 @@ TEST(RffExperimentAppTest, QuickPresetWritesEveryTableAndPlot) {
                                    "/none/plaza.flags: cannot read the "
                                    "flagfile of method 'missing' for plaza"));
 
-  // Solvers: rff x 2 datasets x 24 variants; missing has no options, one
-  // failed row per dataset.
+  // Solvers: rff x 2 datasets x 32 variants (4 solvers x 4 families x 2 D);
+  // missing has no options, one failed row per dataset.
   const std::vector<std::string> solvers =
       Lines(testing::ReadFile(dir + "/solvers.csv"));
-  EXPECT_EQ(solvers.size(), 1u + 2u * 24u + 2u);
+  EXPECT_EQ(solvers.size(), 1u + 2u * 32u + 2u);
 
   // runs.csv: every row of every experiment (figure 2 solves Plaza once per
-  // method): table1 12, figure1 30, table2 5, figure2 1, solvers 48 (2).
+  // method): table1 12, figure1 30, table2 5, figure2 1, solvers 64 (2).
   const std::vector<std::string> runs =
       Lines(testing::ReadFile(dir + "/runs.csv"));
-  EXPECT_EQ(runs.size(), 1u + (12u + 30u + 5u + 1u) * 2u + 48u + 2u);
+  EXPECT_EQ(runs.size(), 1u + (12u + 30u + 5u + 1u) * 2u + 64u + 2u);
 
   const std::string noise = testing::ReadFile(dir + "/figure1_noise.svg");
   EXPECT_THAT(noise, StartsWith("<svg xmlns=\"http://www.w3.org/2000/svg\""));
