@@ -172,6 +172,20 @@ INSTANTIATE_TEST_SUITE_P(
         BadOption{"SplineSmoothingAboveOne",
                   [](SlamOptions* o) { o->spline_smoothing = 1.5; },
                   "spline_smoothing must be in [0, 1]"},
+        BadOption{"UnknownPrior", [](SlamOptions* o) { o->prior = "brownian"; },
+                  "unknown prior 'brownian' (expected rff or wnoa)"},
+        BadOption{"NegativeWnoaQc",
+                  [](SlamOptions* o) {
+                    o->prior = "wnoa";
+                    o->wnoa.position_qc = -1.0;
+                  },
+                  "wnoa position_qc must be > 0, got -1"},
+        BadOption{"NegativeIncrementalLag",
+                  [](SlamOptions* o) {
+                    o->incremental.every = 5;
+                    o->incremental.lag = -2.0;
+                  },
+                  "incremental_lag must be finite and >= 0"},
         BadOption{"UnknownPriorMean",
                   [](SlamOptions* o) { o->prior_mean = "psychic"; },
                   "unknown prior mean 'psychic'"}),
