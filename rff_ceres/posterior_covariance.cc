@@ -8,7 +8,6 @@
 
 #include "Eigen/Eigenvalues"
 #include "ceres/covariance.h"
-#include "ceres/crs_matrix.h"
 #include "rff_ceres/io/text_parser.h"
 
 namespace rff {
@@ -17,39 +16,22 @@ namespace {
 using RowMajorMatrix =
     Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 
-// Landmarks whose own 2x2 block of J^T J is singular: the data fix fewer
-// than two directions of them (one range, or bearings from one place), so
-// the whole information matrix is singular too.
+// Landmarks whose own 2x2 block of J^T J (robustified, as Ceres's
+// covariance sees it) is singular: the data fix fewer than two directions of
+// them (one range, or bearings from one place), so the whole information
+// matrix is singular too.
 std::vector<LandmarkId> UnconstrainedLandmarks(
     SlamProblem* problem, const std::vector<LandmarkId>& ids) {
-  std::vector<double*> blocks;
-  for (const LandmarkId id : ids) blocks.push_back(problem->landmark_block(id));
-  ceres::Problem::EvaluateOptions evaluate;
-  evaluate.parameter_blocks = blocks;
-  ceres::CRSMatrix jacobian;
   std::vector<LandmarkId> unconstrained;
-  if (blocks.empty() || !problem->problem()->Evaluate(
-                            evaluate, nullptr, nullptr, nullptr, &jacobian)) {
-    return unconstrained;
-  }
-  // Columns 2 k and 2 k + 1 belong to landmark k.
-  std::vector<Eigen::Matrix2d> information(ids.size(), Eigen::Matrix2d::Zero());
-  for (int row = 0; row < jacobian.num_rows; ++row) {
-    int landmark = -1;
-    Eigen::Vector2d gradient = Eigen::Vector2d::Zero();
-    for (int k = jacobian.rows[row]; k < jacobian.rows[row + 1]; ++k) {
-      landmark = jacobian.cols[k] / 2;
-      gradient[jacobian.cols[k] % 2] = jacobian.values[k];
-    }
-    if (landmark >= 0) information[landmark] += gradient * gradient.transpose();
-  }
-  for (std::size_t k = 0; k < ids.size(); ++k) {
+  for (const LandmarkId id : ids) {
+    if (!problem->has_landmark(id)) continue;
     const Eigen::Vector2d eigenvalues =
-        Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(information[k],
-                                                       Eigen::EigenvaluesOnly)
+        Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(
+            problem->LandmarkInformation(id, /*apply_loss=*/true),
+            Eigen::EigenvaluesOnly)
             .eigenvalues();
     if (!(eigenvalues[0] > 1e-12 * std::max(eigenvalues[1], 1e-300))) {
-      unconstrained.push_back(ids[k]);
+      unconstrained.push_back(id);
     }
   }
   return unconstrained;

@@ -253,49 +253,48 @@ bool SlamProblem::FindNonFinite(std::string* description) {
   return false;
 }
 
+Eigen::Matrix2d SlamProblem::LandmarkInformation(LandmarkId id,
+                                                 bool apply_loss) {
+  Eigen::Matrix2d information = Eigen::Matrix2d::Zero();
+  const double* position = landmark_block(id);
+  if (position == nullptr) return information;
+  std::vector<double> residuals;
+  std::vector<double> jacobian;
+  std::vector<double*> jacobians;
+  std::vector<double*> parameters;
+  for (const ceres::ResidualBlockId block : landmark_residuals_[id]) {
+    problem_->GetParameterBlocksForResidualBlock(block, &parameters);
+    const int n =
+        problem_->GetCostFunctionForResidualBlock(block)->num_residuals();
+    residuals.assign(n, 0.0);
+    jacobian.assign(2 * n, 0.0);
+    // Only the landmark's Jacobian is asked for.
+    jacobians.assign(parameters.size(), nullptr);
+    for (std::size_t i = 0; i < parameters.size(); ++i) {
+      if (parameters[i] == position) jacobians[i] = jacobian.data();
+    }
+    double cost = 0.0;
+    if (!problem_->EvaluateResidualBlock(block, apply_loss, &cost,
+                                         residuals.data(), jacobians.data())) {
+      continue;
+    }
+    const Eigen::Map<
+        const Eigen::Matrix<double, Eigen::Dynamic, 2, Eigen::RowMajor>>
+        j(jacobian.data(), n, 2);
+    information += j.transpose() * j;
+  }
+  return information;
+}
+
 bool SlamProblem::CheckLandmarksDetermined(double max_condition,
                                            std::string* error) {
-  std::vector<double> residuals;
-  std::vector<std::vector<double>> jacobians;
-  std::vector<double*> jacobian_pointers;
   for (const LandmarkId id : added_) {
     // A prior bounds the information from below in every direction; a huge
     // eigenvalue beside it only says that a bearing sees it from close by.
     if (has_prior_.count(id) > 0) continue;
-    const double* position = landmark_block(id);
-    // Information of the landmark given the trajectory: sum of J_l^T J_l.
-    Eigen::Matrix2d information = Eigen::Matrix2d::Zero();
-    for (const ceres::ResidualBlockId block : landmark_residuals_[id]) {
-      std::vector<double*> parameters;
-      problem_->GetParameterBlocksForResidualBlock(block, &parameters);
-      const ceres::CostFunction* cost =
-          problem_->GetCostFunctionForResidualBlock(block);
-      const int n = cost->num_residuals();
-      residuals.assign(n, 0.0);
-      jacobians.assign(parameters.size(), {});
-      jacobian_pointers.assign(parameters.size(), nullptr);
-      int landmark_index = -1;
-      for (std::size_t i = 0; i < parameters.size(); ++i) {
-        if (parameters[i] != position) continue;
-        landmark_index = static_cast<int>(i);
-        jacobians[i].assign(n * 2, 0.0);
-        jacobian_pointers[i] = jacobians[i].data();
-      }
-      double cost_value = 0.0;
-      if (landmark_index < 0 ||
-          !problem_->EvaluateResidualBlock(block,
-                                           /*apply_loss_function=*/false,
-                                           &cost_value, residuals.data(),
-                                           jacobian_pointers.data())) {
-        continue;
-      }
-      const Eigen::Map<
-          const Eigen::Matrix<double, Eigen::Dynamic, 2, Eigen::RowMajor>>
-          j(jacobians[landmark_index].data(), n, 2);
-      information += j.transpose() * j;
-    }
     const Eigen::Vector2d eigenvalues =
-        Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(information)
+        Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(
+            LandmarkInformation(id, /*apply_loss=*/false))
             .eigenvalues();
     if (!eigenvalues.allFinite() || !(eigenvalues[0] > 0.0) ||
         eigenvalues[1] > max_condition * eigenvalues[0]) {

@@ -106,6 +106,9 @@ class SlamProblem {
   // would be noise.
   bool FindNonFinite(std::string* description);
   bool CheckLandmarksDetermined(double max_condition, std::string* error);
+  // Information of a landmark given the trajectory, sum of J_l^T J_l over its
+  // residuals (through the robust loss if `apply_loss`); zero if unknown.
+  Eigen::Matrix2d LandmarkInformation(LandmarkId id, bool apply_loss);
 
   // Landmarks in group 0 (eliminated first), trajectory blocks in group 1,
   // the range calibration in group 2.
