@@ -291,6 +291,7 @@ bool SolveIncremental(const Dataset& dataset, const SlamOptions& options,
   // Newest time each trajectory block has been touched at (-inf: never).
   std::vector<double> touched(model->num_blocks(),
                               -std::numeric_limits<double>::infinity());
+  auto in_use = [&](int b) { return std::isfinite(touched[b]); };
   auto touch = [&](double t) {
     for (const PoseTerm& term : model->PoseAt(t).terms) {
       touched[term.block] = std::max(touched[term.block], t);
@@ -356,7 +357,7 @@ bool SolveIncremental(const Dataset& dataset, const SlamOptions& options,
     // future would pin the present to the prior mean.
     int used_end = prior_end;
     for (int b = prior_end; b < model->num_blocks(); ++b) {
-      if (touched[b] > -std::numeric_limits<double>::infinity()) {
+      if (in_use(b)) {
         used_end = b + 1;
       }
     }
@@ -367,9 +368,8 @@ bool SolveIncremental(const Dataset& dataset, const SlamOptions& options,
     update.t = now;
     update.num_measurements = static_cast<int>(i + 1);
     for (int b = 0; b < model->num_blocks(); ++b) {
-      const bool active =
-          touched[b] > -std::numeric_limits<double>::infinity() &&
-          (incremental.lag <= 0.0 || touched[b] >= now - incremental.lag);
+      const bool active = in_use(b) && (incremental.lag <= 0.0 ||
+                                        touched[b] >= now - incremental.lag);
       if (active) {
         ceres_problem->SetParameterBlockVariable(model->mutable_block(b));
         ++update.active_blocks;
@@ -401,7 +401,7 @@ bool SolveIncremental(const Dataset& dataset, const SlamOptions& options,
   }
   // Everything the data touched is a variable again, for the covariance.
   for (int b = 0; b < model->num_blocks(); ++b) {
-    if (touched[b] > -std::numeric_limits<double>::infinity()) {
+    if (in_use(b)) {
       ceres_problem->SetParameterBlockVariable(model->mutable_block(b));
     }
   }

@@ -10,13 +10,6 @@
 namespace rff {
 namespace {
 
-bool CheckPositive(const char* name, double value, std::string* error) {
-  if (std::isfinite(value) && value > 0.0) return true;
-  *error =
-      std::string("wnoa ") + name + " must be > 0, got " + FormatNumber(value);
-  return false;
-}
-
 // The 6-vector that reads a * p_c + b * v_c from a state.
 std::shared_ptr<const Eigen::VectorXd> RowPhi(int coordinate, double a,
                                               double b) {
@@ -32,16 +25,16 @@ std::shared_ptr<const Eigen::VectorXd> RowPhi(int coordinate, double a,
 std::unique_ptr<WnoaTrajectory> WnoaTrajectory::Create(
     const WnoaOptions& options, std::shared_ptr<const MeanFunction> mean,
     std::vector<double> state_times, std::string* error) {
-  if (!CheckPositive("position_qc", options.position_qc, error) ||
-      !CheckPositive("heading_qc", options.heading_qc, error) ||
-      !CheckPositive("initial_position_sigma", options.initial_position_sigma,
-                     error) ||
-      !CheckPositive("initial_heading_sigma", options.initial_heading_sigma,
-                     error) ||
-      !CheckPositive("initial_velocity_sigma", options.initial_velocity_sigma,
-                     error) ||
-      !CheckPositive("initial_angular_velocity_sigma",
-                     options.initial_angular_velocity_sigma, error)) {
+  if (!CheckPositiveOption(options.position_qc, "wnoa position_qc", error) ||
+      !CheckPositiveOption(options.heading_qc, "wnoa heading_qc", error) ||
+      !CheckPositiveOption(options.initial_position_sigma,
+                           "wnoa initial_position_sigma", error) ||
+      !CheckPositiveOption(options.initial_heading_sigma,
+                           "wnoa initial_heading_sigma", error) ||
+      !CheckPositiveOption(options.initial_velocity_sigma,
+                           "wnoa initial_velocity_sigma", error) ||
+      !CheckPositiveOption(options.initial_angular_velocity_sigma,
+                           "wnoa initial_angular_velocity_sigma", error)) {
     return nullptr;
   }
   if (!(std::isfinite(options.min_state_spacing) &&

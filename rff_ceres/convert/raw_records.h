@@ -58,21 +58,6 @@ inline bool ParseRawInteger(const LineReader& reader, std::string_view field,
   return true;
 }
 
-// Option checks of the converters: `value` must be finite and > 0 (>= 0);
-// otherwise `error` names the option and the value.
-inline bool CheckPositiveOption(double value, const char* name,
-                                std::string* error) {
-  if (value > 0.0 && std::isfinite(value)) return true;
-  *error = std::string(name) + " must be > 0, got " + FormatNumber(value);
-  return false;
-}
-inline bool CheckNonNegativeOption(double value, const char* name,
-                                   std::string* error) {
-  if (value >= 0.0 && std::isfinite(value)) return true;
-  *error = std::string(name) + " must be >= 0, got " + FormatNumber(value);
-  return false;
-}
-
 }  // namespace rff
 
 #endif  // RFF_CERES_CONVERT_RAW_RECORDS_H_

@@ -7,6 +7,7 @@
 #ifndef RFF_CERES_IO_TEXT_PARSER_H_
 #define RFF_CERES_IO_TEXT_PARSER_H_
 
+#include <cmath>
 #include <cstdint>
 #include <fstream>
 #include <istream>
@@ -92,6 +93,21 @@ bool OpenForWriting(const std::string& path, std::ofstream* stream,
 // Flushes `stream` and reports a failed write of `path` through `error`.
 bool FinishWriting(const std::string& path, std::ofstream* stream,
                    std::string* error);
+
+// Option checks (converters, trajectory models): `value` must be finite and
+// > 0 (>= 0); otherwise `error` names the option and the value.
+inline bool CheckPositiveOption(double value, const char* name,
+                                std::string* error) {
+  if (value > 0.0 && std::isfinite(value)) return true;
+  *error = std::string(name) + " must be > 0, got " + FormatNumber(value);
+  return false;
+}
+inline bool CheckNonNegativeOption(double value, const char* name,
+                                   std::string* error) {
+  if (value >= 0.0 && std::isfinite(value)) return true;
+  *error = std::string(name) + " must be >= 0, got " + FormatNumber(value);
+  return false;
+}
 
 }  // namespace rff
 
