@@ -73,7 +73,8 @@ DEFINE_string(loss, "none",
 DEFINE_double(loss_scale, 1.0, "Robust loss scale, in sigmas.");
 DEFINE_bool(estimate_range_calibration, false,
             "Estimate a range sensor model scale * distance + offset jointly "
-            "(one per run), for ranges with a systematic bias.");
+            "(one per run) for the ranges of RANGE and RANGE_BEARING records, "
+            "for ranges with a systematic bias.");
 DEFINE_double(range_scale_sigma, 0.1,
               "Prior sigma of the range scale around 1.");
 DEFINE_double(range_offset_sigma, 1.0,

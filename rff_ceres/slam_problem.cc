@@ -80,8 +80,14 @@ void SlamProblem::AddObservation(const Observation& o) {
       cost = new BearingCost(std::move(map), o.bearing, o.sigma_bearing);
       break;
     case ObservationType::kRangeBearing:
-      cost = new RangeBearingCost(std::move(map), o.range, o.bearing,
-                                  o.sigma_range, o.sigma_bearing);
+      if (options_.range_calibration.estimate) {
+        blocks.push_back(range_calibration_.data());
+        cost = new CalibratedRangeBearingCost(
+            std::move(map), o.range, o.bearing, o.sigma_range, o.sigma_bearing);
+      } else {
+        cost = new RangeBearingCost(std::move(map), o.range, o.bearing,
+                                    o.sigma_range, o.sigma_bearing);
+      }
       break;
   }
   const char* kinds[] = {"range", "bearing", "range-bearing"};

@@ -34,9 +34,10 @@ struct LossOptions {
 bool CreateLoss(const LossOptions& options,
                 std::unique_ptr<ceres::LossFunction>* loss, std::string* error);
 
-// Self-calibration of the range sensor: every RANGE record is modelled as
-// scale * distance + offset with one (scale, offset) for the whole run, under
-// the prior scale ~ N(1, scale_sigma^2), offset ~ N(0, offset_sigma^2).
+// Self-calibration of the range sensor: the range of every RANGE and
+// RANGE_BEARING record is modelled as scale * distance + offset with one
+// (scale, offset) for the whole run, under the prior scale ~ N(1,
+// scale_sigma^2), offset ~ N(0, offset_sigma^2).
 struct RangeCalibrationOptions {
   bool estimate = false;
   double scale_sigma = 0.1;

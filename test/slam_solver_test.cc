@@ -261,6 +261,25 @@ TEST(SlamSolverTest, RangeCalibrationIsRecovered) {
             0.7 * ApeTranslation(dataset, biased));
 }
 
+TEST(SlamSolverTest, RangeCalibrationCoversRangeBearingRecords) {
+  SimulationOptions sim = PaperOptions(19);
+  sim.num_landmarks = 20;
+  Dataset dataset;
+  std::string error;
+  ASSERT_TRUE(Simulate(sim, &dataset, &error)) << error;
+  for (Observation& o : dataset.observations) o.range = 1.06 * o.range + 0.4;
+  SlamOptions options = PaperSolverOptions();
+  SlamResult biased;
+  ASSERT_TRUE(RunSlam(dataset, options, &biased, &error)) << error;
+  options.problem.range_calibration.estimate = true;
+  SlamResult calibrated;
+  ASSERT_TRUE(RunSlam(dataset, options, &calibrated, &error)) << error;
+  EXPECT_NEAR(calibrated.range_calibration[0], 1.06, 0.01);
+  EXPECT_NEAR(calibrated.range_calibration[1], 0.4, 0.3);
+  EXPECT_LT(ApeTranslation(dataset, calibrated),
+            ApeTranslation(dataset, biased));
+}
+
 TEST(SlamSolverTest, IncrementalModeRejectsOuterRounds) {
   SimulationOptions sim = PaperOptions(15);
   sim.num_steps = 20;

@@ -57,6 +57,66 @@ TEST(CalibratedRangeCostTest, ResidualAppliesScaleAndOffset) {
   EXPECT_NEAR(r, (5.7 - 5.2) / 0.5, 1e-12);
 }
 
+// Independent twin: the calibrated range row over the plain bearing row.
+struct CalibratedRangeBearingAutoDiff {
+  PoseMap map;
+  double range, bearing, sigma_range, sigma_bearing;
+  int landmark_block;
+  template <typename T>
+  bool operator()(T const* const* p, T* r) const {
+    const auto pose = PoseOf(map, p);
+    const T dx = p[landmark_block][0] - pose[0];
+    const T dy = p[landmark_block][1] - pose[1];
+    const T* calibration = p[landmark_block + 1];
+    r[0] = (calibration[0] * sqrt(dx * dx + dy * dy) + calibration[1] - range) /
+           sigma_range;
+    r[1] = testing::Wrap(T(atan2(dy, dx) - pose[2] - bearing)) / sigma_bearing;
+    return true;
+  }
+};
+
+TEST(CalibratedRangeBearingCostTest, AnalyticJacobianMatchesAutoDiff) {
+  std::mt19937 rng(5);
+  for (int trial = 0; trial < 20; ++trial) {
+    const PoseMap map = testing::RandomPoseMap(&rng);
+    const double bearing = -2.5 + 0.25 * trial;
+    const CalibratedRangeBearingCost cost(map, 6.1, bearing, 0.4, 0.03);
+    auto autodiff = testing::MakeAutoDiff(
+        new CalibratedRangeBearingAutoDiff{map, 6.1, bearing, 0.4, 0.03, 3},
+        cost);
+    auto parameters =
+        testing::RandomParameters(cost.parameter_block_sizes(), &rng);
+    parameters[3] = {8.0 - trial, 5.0 + 0.2 * trial};
+    parameters[4] = {1.0 + 0.01 * trial, 0.3 - 0.05 * trial};
+    testing::ExpectSameCost(cost, *autodiff, parameters);
+  }
+}
+
+TEST(CalibratedRangeBearingCostTest, CalibrationDoesNotTouchTheBearing) {
+  // Pose (1, 2, 0.1); landmark at distance 5 on a bearing of
+  // atan2(4, 3) - 0.1; model 1.1 * 5 + 0.2 = 5.7 against a reading of 5.2.
+  PoseMap map;
+  map.mean << 1.0, 2.0, 0.1;
+  map.terms.push_back(
+      {0, 0, std::make_shared<Eigen::VectorXd>(Eigen::VectorXd::Ones(1))});
+  const double true_bearing = std::atan2(4.0, 3.0) - 0.1;
+  const CalibratedRangeBearingCost cost(map, 5.2, true_bearing + 0.01, 0.5,
+                                        0.02);
+  const double b[1] = {0.0};
+  const double l[2] = {4.0, 6.0};
+  const double c[2] = {1.1, 0.2};
+  const double* parameters[3] = {b, l, c};
+  double r[2];
+  double jb[2], jl[4], jc[4];
+  double* jacobians[3] = {jb, jl, jc};
+  ASSERT_TRUE(cost.Evaluate(parameters, r, jacobians));
+  EXPECT_NEAR(r[0], (5.7 - 5.2) / 0.5, 1e-12);
+  EXPECT_NEAR(r[1], -0.01 / 0.02, 1e-12);
+  // The bearing row has no calibration Jacobian.
+  EXPECT_DOUBLE_EQ(jc[2], 0.0);
+  EXPECT_DOUBLE_EQ(jc[3], 0.0);
+}
+
 TEST(DiagonalPriorCostTest, ResidualAndJacobian) {
   const DiagonalPriorCost cost(Eigen::Vector2d(1.0, 0.0),
                                Eigen::Vector2d(0.1, 2.0));
