@@ -71,6 +71,10 @@ DEFINE_double(spline_smoothing, 0.98,
 DEFINE_string(loss, "none",
               "Robust loss on observations: none, huber, cauchy.");
 DEFINE_double(loss_scale, 1.0, "Robust loss scale, in sigmas.");
+DEFINE_string(odometry_loss, "none",
+              "Robust loss on odometry residuals: none, huber, cauchy.");
+DEFINE_double(odometry_loss_scale, 1.0,
+              "Robust odometry loss scale, in sigmas.");
 DEFINE_bool(estimate_range_calibration, false,
             "Estimate a range sensor model scale * distance + offset jointly "
             "(one per run) for the ranges of RANGE and RANGE_BEARING records, "
@@ -145,6 +149,8 @@ SlamOptions SlamOptionsFromFlags() {
   t.segment_overlap = FLAGS_segment_overlap;
   options.problem.loss.name = FLAGS_loss;
   options.problem.loss.scale = FLAGS_loss_scale;
+  options.problem.odometry_loss.name = FLAGS_odometry_loss;
+  options.problem.odometry_loss.scale = FLAGS_odometry_loss_scale;
   options.problem.use_odometry = FLAGS_use_odometry;
   RangeCalibrationOptions& calibration = options.problem.range_calibration;
   calibration.estimate = FLAGS_estimate_range_calibration;

@@ -98,6 +98,10 @@ void SlamProblem::AddObservation(const Observation& o) {
 bool SlamProblem::Begin(const std::vector<LandmarkId>& landmark_ids,
                         std::string* error) {
   if (!CreateLoss(options_.loss, &loss_, error)) return false;
+  if (!CreateLoss(options_.odometry_loss, &odometry_loss_, error)) {
+    *error = "odometry loss: " + *error;
+    return false;
+  }
   for (const LandmarkId id : landmark_ids) slots_.emplace(id, 0);
   int slot = 0;
   for (auto& [id, index] : slots_) index = slot++;
@@ -167,7 +171,7 @@ void SlamProblem::AddOdometry(const PreintegratedOdometry& o) {
   Remember(problem_->AddResidualBlock(
                new OdometryCost(std::move(map0), std::move(map1), o.motion,
                                 SqrtInformation(o.covariance)),
-               nullptr, blocks),
+               odometry_loss_.get(), blocks),
            {"odometry", o.t0, o.t1});
 }
 

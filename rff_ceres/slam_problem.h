@@ -46,6 +46,9 @@ struct RangeCalibrationOptions {
 
 struct ProblemOptions {
   LossOptions loss;
+  // On the whitened odometry residuals (commanded velocities have heavy
+  // tails where the robot lags its commands).
+  LossOptions odometry_loss;
   RangeCalibrationOptions range_calibration;
   bool use_odometry = true;
   // Compose ODOM chains between observation times into one residual each
@@ -140,6 +143,7 @@ class SlamProblem {
   // Ceres's own lookup scans every residual (without fast removal).
   std::map<LandmarkId, std::vector<ceres::ResidualBlockId>> landmark_residuals_;
   std::unique_ptr<ceres::LossFunction> loss_;
+  std::unique_ptr<ceres::LossFunction> odometry_loss_;
   std::unique_ptr<ceres::Problem> problem_;
   // Landmark blocks in one buffer in id order (Ceres orders an elimination
   // group by address: this keeps the solve's arithmetic reproducible).

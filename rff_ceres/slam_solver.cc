@@ -605,6 +605,8 @@ bool WriteSummaryJson(const SlamOptions& options, const SlamResult& result,
       << "  \"wnoa_heading_qc\": " << FormatNumber(options.wnoa.heading_qc)
       << ",\n"
       << "  \"loss\": " << JsonString(options.problem.loss.name) << ",\n"
+      << "  \"odometry_loss\": "
+      << JsonString(options.problem.odometry_loss.name) << ",\n"
       << "  \"linear_solver\": " << JsonString(options.solver.linear_solver)
       << ",\n"
       << "  \"termination\": "
