@@ -9,6 +9,17 @@ DEFINE_string(prior, "rff",
               "the gpslam baseline).");
 DEFINE_string(prior_mean, "auto",
               "Prior mean: auto, odometry, localization, spline or constant.");
+DEFINE_double(localization_position_smoothing, 0.2,
+              "Localization mean: acceleration noise density of the position "
+              "smoother (m^2/s^3); larger follows the fixes more closely.");
+DEFINE_double(localization_heading_smoothing, 0.005,
+              "Localization mean: the same for the heading (rad^2/s^3).");
+DEFINE_double(localization_correction_smoothing, 1e-4,
+              "Localization mean with odometry: density of the smoother of "
+              "the correction to dead reckoning.");
+DEFINE_bool(localization_use_odometry, true,
+            "Localization mean: fuse the ODOM records (dead reckoning "
+            "corrected towards the fixes) when the dataset has them.");
 DEFINE_string(kernel, "rbf",
               "Kernel of x and y: rbf, matern12, matern32, matern52, "
               "periodic.");
@@ -115,6 +126,11 @@ SlamOptions SlamOptionsFromFlags() {
   SlamOptions options;
   options.prior = FLAGS_prior;
   options.prior_mean = FLAGS_prior_mean;
+  LocalizationOptions& localization = options.localization;
+  localization.position_smoothing = FLAGS_localization_position_smoothing;
+  localization.heading_smoothing = FLAGS_localization_heading_smoothing;
+  localization.correction_smoothing = FLAGS_localization_correction_smoothing;
+  localization.use_odometry = FLAGS_localization_use_odometry;
   WnoaOptions& w = options.wnoa;
   w.position_qc = FLAGS_wnoa_position_qc;
   w.heading_qc = FLAGS_wnoa_heading_qc;

@@ -454,7 +454,7 @@ bool RunSlam(const Dataset& dataset, const SlamOptions& options,
   }
 
   std::shared_ptr<const MeanFunction> mean =
-      BuildPriorMean(options.prior_mean, dataset, error);
+      BuildPriorMean(options.prior_mean, dataset, options.localization, error);
   if (!mean) return false;
   std::unique_ptr<TrajectoryModel> model =
       CreateTrajectoryModel(dataset, options, mean, error);

@@ -13,6 +13,7 @@
 #include "Eigen/Core"
 #include "ceres/solver.h"
 #include "rff_ceres/feature_trajectory.h"
+#include "rff_ceres/mean/localization_mean.h"
 #include "rff_ceres/slam_problem.h"
 #include "rff_ceres/types.h"
 #include "rff_ceres/wnoa_trajectory.h"
@@ -52,6 +53,8 @@ struct SlamOptions {
   // "wnoa" (LTV-SDE states, WnoaTrajectory).
   std::string prior = "rff";
   std::string prior_mean = "auto";
+  // Tuning of the "localization" mean (docs/prior_means.md).
+  LocalizationOptions localization;
   FeatureTrajectoryOptions trajectory;
   WnoaOptions wnoa;
   ProblemOptions problem;

@@ -218,6 +218,12 @@ const AppCase kAppCases[] = {
     {"SlamUnknownOdometryLoss", SLAM "--odometry_loss=l1" SLAM_OUT,
      "odometry loss: unknown loss 'l1' (expected none, huber or cauchy)",
      "{dir}/out.tum"},
+    {"SlamNegativeLocalizationSmoothing",
+     SLAM "--prior_mean=localization "
+          "--localization_correction_smoothing=-1" SLAM_OUT,
+     "prior mean 'localization': localization_correction_smoothing must be "
+     "finite and > 0, got -1",
+     "{dir}/out.tum"},
     {"SlamUnknownPriorMean", SLAM "--prior_mean=psychic" SLAM_OUT,
      "unknown prior mean 'psychic'", "{dir}/out.tum"},
     {"SlamNegativeOuterRounds", SLAM "--outer_rounds=-1" SLAM_OUT,

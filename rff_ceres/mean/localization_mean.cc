@@ -317,11 +317,31 @@ std::vector<Eigen::Vector3d> Seeds(
 
 }  // namespace
 
+bool CheckLocalizationOptions(const LocalizationOptions& options,
+                              std::string* error) {
+  for (const auto& [name, value] :
+       {std::make_pair("position_smoothing", options.position_smoothing),
+        std::make_pair("heading_smoothing", options.heading_smoothing),
+        std::make_pair("correction_smoothing", options.correction_smoothing),
+        std::make_pair("held_heading_sigma", options.held_heading_sigma)}) {
+    if (!(value > 0.0) || !std::isfinite(value)) {
+      *error = std::string("localization_") + name +
+               " must be finite and > 0, got " + FormatNumber(value);
+      return false;
+    }
+  }
+  return true;
+}
+
 std::shared_ptr<const MeanFunction> BuildLocalizationMean(
     const Dataset& dataset, const LocalizationOptions& options,
     LocalizationReport* report, std::string* error) {
   *report = LocalizationReport();
   const std::string prefix = "prior mean 'localization': ";
+  if (!CheckLocalizationOptions(options, error)) {
+    *error = prefix + *error;
+    return nullptr;
+  }
   std::map<LandmarkId, KnownLandmark> landmarks;
   for (const LandmarkPrior& l : dataset.landmark_priors) {
     landmarks[l.id] = {Eigen::Vector2d(l.x, l.y), l.sigma};

@@ -95,6 +95,11 @@ struct LocalizationReport {
   std::vector<PoseFix> fixes;  // The kept fixes, in time order.
 };
 
+// Fails, naming the option as localization_<field>, when a smoothing density
+// or the held heading sigma is not finite and positive.
+bool CheckLocalizationOptions(const LocalizationOptions& options,
+                              std::string* error);
+
 // Builds the mean. Fails with a clear message when the dataset has no
 // landmark priors, or when no time can be localised.
 std::shared_ptr<const MeanFunction> BuildLocalizationMean(

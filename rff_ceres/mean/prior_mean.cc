@@ -39,9 +39,20 @@ std::string NameList() {
 std::shared_ptr<const MeanFunction> BuildPriorMean(const std::string& name,
                                                    const Dataset& dataset,
                                                    std::string* error) {
+  return BuildPriorMean(name, dataset, LocalizationOptions(), error);
+}
+
+std::shared_ptr<const MeanFunction> BuildPriorMean(
+    const std::string& name, const Dataset& dataset,
+    const LocalizationOptions& localization, std::string* error) {
   const std::vector<std::string> names = PriorMeanNames();
   if (std::find(names.begin(), names.end(), name) == names.end()) {
     *error = "unknown prior mean '" + name + "' (expected " + NameList() + ")";
+    return nullptr;
+  }
+  // Checked whatever the name: "auto" and "spline" may localise.
+  if (!CheckLocalizationOptions(localization, error)) {
+    *error = "prior mean '" + name + "': " + *error;
     return nullptr;
   }
   if (dataset.pose_priors.empty()) {
@@ -50,12 +61,13 @@ std::shared_ptr<const MeanFunction> BuildPriorMean(const std::string& name,
   }
   if (name == "auto") {
     if (!dataset.odometry.empty()) {
-      return BuildPriorMean("odometry", dataset, error);
+      return BuildPriorMean("odometry", dataset, localization, error);
     }
     std::string ignored;
     std::shared_ptr<const MeanFunction> mean =
-        BuildPriorMean("localization", dataset, &ignored);
-    return mean ? mean : BuildPriorMean("constant", dataset, error);
+        BuildPriorMean("localization", dataset, localization, &ignored);
+    return mean ? mean
+                : BuildPriorMean("constant", dataset, localization, error);
   }
   if (name == "constant") {
     return std::make_shared<PiecewiseLinearMean>(
@@ -73,12 +85,11 @@ std::shared_ptr<const MeanFunction> BuildPriorMean(const std::string& name,
   }
   if (name == "localization") {
     LocalizationReport report;
-    return BuildLocalizationMean(dataset, LocalizationOptions(), &report,
-                                 error);
+    return BuildLocalizationMean(dataset, localization, &report, error);
   }
   // "spline": through the auto mean at every observation and prior time.
   std::shared_ptr<const MeanFunction> base =
-      BuildPriorMean("auto", dataset, error);
+      BuildPriorMean("auto", dataset, localization, error);
   if (!base) return nullptr;
   std::vector<double> times;
   for (const Observation& o : dataset.observations) times.push_back(o.t);

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "rff_ceres/mean/localization_mean.h"
 #include "rff_ceres/mean/mean_function.h"
 #include "rff_ceres/types.h"
 
@@ -25,6 +26,11 @@ std::vector<std::string> PriorMeanNames();
 // "constant": the earliest PRIOR_POSE at every time.
 // "auto": odometry if the dataset has ODOM records, else localization if
 //   some time can be localised, else constant.
+// "localization" (also through "auto" and "spline") uses `localization`.
+std::shared_ptr<const MeanFunction> BuildPriorMean(
+    const std::string& name, const Dataset& dataset,
+    const LocalizationOptions& localization, std::string* error);
+// The same with the default LocalizationOptions.
 std::shared_ptr<const MeanFunction> BuildPriorMean(const std::string& name,
                                                    const Dataset& dataset,
                                                    std::string* error);

@@ -179,5 +179,56 @@ TEST(PriorMeanTest, AutoLocalisesWithoutOdometryAndSplineFollows) {
   EXPECT_GT(std::hypot(p.x() - last.x, p.y() - last.y), 5.0);
 }
 
+TEST(PriorMeanTest, LocalizationOptionsReachTheMean) {
+  // With odometry fusion switched off, the mean is the smoothed fixes alone
+  // (not exact between them); with it, dead reckoning makes it exact.
+  const Dataset dataset = NoiseFree(MeasurementKind::kRangeBearing, true);
+  LocalizationOptions fixes_only;
+  fixes_only.use_odometry = false;
+  std::string error;
+  std::shared_ptr<const MeanFunction> fused =
+      BuildPriorMean("localization", dataset, LocalizationOptions(), &error);
+  std::shared_ptr<const MeanFunction> unfused =
+      BuildPriorMean("localization", dataset, fixes_only, &error);
+  ASSERT_NE(fused, nullptr) << error;
+  ASSERT_NE(unfused, nullptr) << error;
+  double fused_max = 0.0, unfused_max = 0.0;
+  for (const TimedPose& truth : dataset.ground_truth) {
+    const double t = truth.t + 0.5;  // Between the fixes.
+    if (t > dataset.ground_truth.back().t) break;
+    const Eigen::Vector3d a = fused->Evaluate(t);
+    const Eigen::Vector3d b = unfused->Evaluate(t);
+    const Eigen::Vector3d c = fused->Evaluate(truth.t);
+    unfused_max = std::max(unfused_max, (a - b).head<2>().norm());
+    fused_max =
+        std::max(fused_max, std::hypot(c.x() - truth.x, c.y() - truth.y));
+  }
+  EXPECT_LT(fused_max, 1e-3);
+  EXPECT_GT(unfused_max, 1e-3);
+}
+
+TEST(PriorMeanTest, BadLocalizationOptionsAreNamedForEveryMean) {
+  const Dataset dataset = NoiseFree(MeasurementKind::kRangeBearing, true);
+  LocalizationOptions options;
+  options.correction_smoothing = 0.0;
+  std::string error;
+  EXPECT_EQ(BuildPriorMean("localization", dataset, options, &error), nullptr);
+  EXPECT_EQ(error,
+            "prior mean 'localization': localization_correction_smoothing "
+            "must be finite and > 0, got 0");
+  // "auto" would localise without odometry: it must not fall back silently.
+  options = LocalizationOptions();
+  options.position_smoothing = std::nan("");
+  EXPECT_EQ(BuildPriorMean("auto", dataset, options, &error), nullptr);
+  EXPECT_EQ(error,
+            "prior mean 'auto': localization_position_smoothing must be "
+            "finite and > 0, got nan");
+  options = LocalizationOptions();
+  options.held_heading_sigma = -0.1;
+  LocalizationReport report;
+  EXPECT_EQ(BuildLocalizationMean(dataset, options, &report, &error), nullptr);
+  EXPECT_THAT(error, HasSubstr("localization_held_heading_sigma"));
+}
+
 }  // namespace
 }  // namespace rff
