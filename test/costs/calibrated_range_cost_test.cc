@@ -25,6 +25,17 @@ struct CalibratedRangeAutoDiff {
   }
 };
 
+// Random blocks for a cost over the random pose map's blocks 0-2, a landmark
+// (block 3) and the calibration (block 4), the last two set by `trial`.
+std::vector<std::vector<double>> CalibratedParameters(
+    const ceres::CostFunction& cost, int trial, std::mt19937* rng) {
+  auto parameters =
+      testing::RandomParameters(cost.parameter_block_sizes(), rng);
+  parameters[3] = {8.0 - trial, 5.0 + 0.2 * trial};
+  parameters[4] = {1.0 + 0.01 * trial, 0.3 - 0.05 * trial};
+  return parameters;
+}
+
 TEST(CalibratedRangeCostTest, AnalyticJacobianMatchesAutoDiff) {
   std::mt19937 rng(3);
   for (int trial = 0; trial < 20; ++trial) {
@@ -32,11 +43,8 @@ TEST(CalibratedRangeCostTest, AnalyticJacobianMatchesAutoDiff) {
     const CalibratedRangeCost cost(map, 6.1, 0.4);
     auto autodiff = testing::MakeAutoDiff(
         new CalibratedRangeAutoDiff{map, 6.1, 0.4, 3}, cost);
-    auto parameters =
-        testing::RandomParameters(cost.parameter_block_sizes(), &rng);
-    parameters[3] = {8.0 - trial, 5.0 + 0.2 * trial};
-    parameters[4] = {1.0 + 0.01 * trial, 0.3 - 0.05 * trial};
-    testing::ExpectSameCost(cost, *autodiff, parameters);
+    testing::ExpectSameCost(cost, *autodiff,
+                            CalibratedParameters(cost, trial, &rng));
   }
 }
 
@@ -57,19 +65,18 @@ TEST(CalibratedRangeCostTest, ResidualAppliesScaleAndOffset) {
   EXPECT_NEAR(r, (5.7 - 5.2) / 0.5, 1e-12);
 }
 
-// Independent twin: the calibrated range row over the plain bearing row.
+// Independent twin: the calibrated range row (the twin above) over the plain
+// bearing row.
 struct CalibratedRangeBearingAutoDiff {
   PoseMap map;
   double range, bearing, sigma_range, sigma_bearing;
   int landmark_block;
   template <typename T>
   bool operator()(T const* const* p, T* r) const {
+    CalibratedRangeAutoDiff{map, range, sigma_range, landmark_block}(p, r);
     const auto pose = PoseOf(map, p);
     const T dx = p[landmark_block][0] - pose[0];
     const T dy = p[landmark_block][1] - pose[1];
-    const T* calibration = p[landmark_block + 1];
-    r[0] = (calibration[0] * sqrt(dx * dx + dy * dy) + calibration[1] - range) /
-           sigma_range;
     r[1] = testing::Wrap(T(atan2(dy, dx) - pose[2] - bearing)) / sigma_bearing;
     return true;
   }
@@ -84,11 +91,8 @@ TEST(CalibratedRangeBearingCostTest, AnalyticJacobianMatchesAutoDiff) {
     auto autodiff = testing::MakeAutoDiff(
         new CalibratedRangeBearingAutoDiff{map, 6.1, bearing, 0.4, 0.03, 3},
         cost);
-    auto parameters =
-        testing::RandomParameters(cost.parameter_block_sizes(), &rng);
-    parameters[3] = {8.0 - trial, 5.0 + 0.2 * trial};
-    parameters[4] = {1.0 + 0.01 * trial, 0.3 - 0.05 * trial};
-    testing::ExpectSameCost(cost, *autodiff, parameters);
+    testing::ExpectSameCost(cost, *autodiff,
+                            CalibratedParameters(cost, trial, &rng));
   }
 }
 
