@@ -8,7 +8,12 @@ DEFINE_string(prior, "rff",
               "method) or wnoa (LTV-SDE white-noise-on-acceleration states, "
               "the gpslam baseline).");
 DEFINE_string(prior_mean, "auto",
-              "Prior mean: auto, odometry, localization, spline or constant.");
+              "Prior mean: auto (odometry if the dataset has ODOM, else "
+              "constant), odometry, localization, spline or constant.");
+DEFINE_string(initial_trajectory, "auto",
+              "Initial value of the trajectory: auto (fit to a localisation "
+              "against the landmark priors when one can be built, else the "
+              "prior mean) or mean.");
 DEFINE_double(localization_position_smoothing, 0.2,
               "Localization mean: acceleration noise density of the position "
               "smoother (m^2/s^3); larger follows the fixes more closely.");
@@ -35,8 +40,18 @@ DEFINE_double(heading_kernel_variance, 0.1,
 DEFINE_double(period, 1.0, "Period of the periodic kernel (seconds).");
 DEFINE_string(features, "hilbert",
               "Feature family: rff, qmc, gauss_hermite, hilbert.");
-DEFINE_int32(num_features, 100, "Features per coordinate of x and y (D).");
+DEFINE_int32(num_features, 0,
+             "Features per coordinate of x and y (D) per segment; 0 (auto): "
+             "D, the segment length and the overlap follow the lengthscales "
+             "so that the motion the basis misses stays below 5 cm and "
+             "0.005 rad.");
 DEFINE_int32(num_heading_features, 0, "Features of theta (0: --num_features).");
+DEFINE_string(learn_hyperparameters, "auto",
+              "RFF: learn the lengthscales and variances of x, y and theta "
+              "by the Laplace approximation of the marginal likelihood on the "
+              "first 300 s, starting from --lengthscale, --kernel_variance, "
+              "...: on, off, or auto (on for data without odometry; batch "
+              "mode only).");
 DEFINE_uint64(seed, 1, "Seed of the random feature frequencies.");
 DEFINE_double(segment_length, 0.0,
               "Windowed weights: segment length in seconds (0: one global "
@@ -102,8 +117,10 @@ DEFINE_double(max_preintegration_seconds, 1.0,
               "Longest time one preintegrated odometry chain may span.");
 
 // Ceres.
-DEFINE_string(linear_solver, "DENSE_SCHUR",
-              "Ceres linear solver: DENSE_SCHUR, SPARSE_SCHUR, "
+DEFINE_string(linear_solver, "auto",
+              "Ceres linear solver: auto (DENSE_SCHUR when at most 2000 "
+              "trajectory parameters remain after eliminating the landmarks, "
+              "else SPARSE_NORMAL_CHOLESKY), DENSE_SCHUR, SPARSE_SCHUR, "
               "ITERATIVE_SCHUR, DENSE_QR, SPARSE_NORMAL_CHOLESKY, CGNR, ...");
 DEFINE_string(preconditioner, "auto",
               "Ceres preconditioner of ITERATIVE_SCHUR and CGNR: IDENTITY, "
@@ -126,6 +143,7 @@ SlamOptions SlamOptionsFromFlags() {
   SlamOptions options;
   options.prior = FLAGS_prior;
   options.prior_mean = FLAGS_prior_mean;
+  options.initial_trajectory = FLAGS_initial_trajectory;
   LocalizationOptions& localization = options.localization;
   localization.position_smoothing = FLAGS_localization_position_smoothing;
   localization.heading_smoothing = FLAGS_localization_heading_smoothing;
@@ -142,6 +160,7 @@ SlamOptions SlamOptionsFromFlags() {
   options.incremental.every = FLAGS_incremental_every;
   options.incremental.lag = FLAGS_incremental_lag;
   options.outer_rounds = FLAGS_outer_rounds;
+  options.learn_hyperparameters = FLAGS_learn_hyperparameters;
   options.spline_smoothing = FLAGS_spline_smoothing;
   FeatureTrajectoryOptions& t = options.trajectory;
   t.position_kernel.name = FLAGS_kernel;

@@ -4,13 +4,75 @@
 #include <cmath>
 
 #include "costs/weight_prior_cost.h"
+#include "rff_ceres/features/hilbert_features.h"
 
 namespace rff {
 
+namespace {
+
+// A segment spans this many position lengthscales and blends into the next
+// over this many: correlations beyond ~4 lengthscales are below 1e-3 (rbf).
+constexpr double kSegmentLengthscales = 10.0;
+constexpr double kOverlapLengthscales = 4.0;
+
+// D of one feature map of `kernel` over [begin, end] at `tolerance`.
+int AutoNumFeatures(const KernelOptions& kernel_options, double missed_sigma,
+                    const FeatureTrajectoryOptions& options, double begin,
+                    double end) {
+  std::string error;
+  const std::unique_ptr<Kernel> kernel = CreateKernel(kernel_options, &error);
+  if (!kernel) return 1;  // Create() reports the bad kernel.
+  FeatureMapOptions map;
+  map.family = options.family;
+  map.window_begin = begin;
+  map.window_end = end;
+  const double tolerance = missed_sigma * missed_sigma;
+  if (options.family == "hilbert" && kernel->has_spectral_density()) {
+    return std::min(HilbertNumFeatures(*kernel, map, tolerance),
+                    kMaxAutoFeatures);
+  }
+  int d = kMaxAutoFeatures;
+  if (!DefaultNumFeatures(*kernel, map, tolerance, kMaxAutoFeatures, &d,
+                          &error)) {
+    d = kMaxAutoFeatures;
+  }
+  return d;
+}
+
+}  // namespace
+
+FeatureTrajectoryOptions AutoCapacity(const FeatureTrajectoryOptions& options,
+                                      double duration) {
+  FeatureTrajectoryOptions filled = options;
+  if (options.num_position_features != kAutoCapacity) return filled;
+  const double lengthscale = options.position_kernel.lengthscale;
+  if (options.segment_length == 0.0 &&
+      duration > 1.5 * kSegmentLengthscales * lengthscale) {
+    filled.segment_length = kSegmentLengthscales * lengthscale;
+    filled.segment_overlap = kOverlapLengthscales * lengthscale;
+  }
+  // Every segment has the length of the first (Create splits evenly).
+  const int segments =
+      filled.segment_length > 0.0
+          ? std::max(1, static_cast<int>(
+                            std::ceil(duration / filled.segment_length - 1e-9)))
+          : 1;
+  const double window = duration / segments + filled.segment_overlap;
+  filled.num_position_features =
+      AutoNumFeatures(options.position_kernel, options.capacity_position_sigma,
+                      options, 0.0, window);
+  filled.num_heading_features =
+      AutoNumFeatures(options.heading_kernel, options.capacity_heading_sigma,
+                      options, 0.0, window);
+  return filled;
+}
+
 std::unique_ptr<FeatureTrajectory> FeatureTrajectory::Create(
-    const FeatureTrajectoryOptions& options,
+    const FeatureTrajectoryOptions& requested,
     std::shared_ptr<const MeanFunction> mean, double t_begin, double t_end,
     std::string* error) {
+  const FeatureTrajectoryOptions options =
+      AutoCapacity(requested, std::max(t_end - t_begin, 1e-3));
   if (!(options.segment_length >= 0.0) || !(options.segment_overlap >= 0.0) ||
       (options.segment_length > 0.0 &&
        !(options.segment_overlap < options.segment_length))) {
@@ -18,6 +80,7 @@ std::unique_ptr<FeatureTrajectory> FeatureTrajectory::Create(
     return nullptr;
   }
   std::unique_ptr<FeatureTrajectory> model(new FeatureTrajectory);
+  model->options_ = options;
   model->mean_ = std::move(mean);
   model->origin_ = t_begin;
   // A run with one time still needs a window of positive length.

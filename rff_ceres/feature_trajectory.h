@@ -33,12 +33,31 @@ struct FeatureTrajectoryOptions {
   KernelOptions position_kernel;  // x and y
   KernelOptions heading_kernel;   // theta
   std::string family = "hilbert";
+  // D of x and y and of theta per segment; kAutoCapacity derives D, the
+  // segment length and the overlap from the lengthscales (AutoCapacity).
   int num_position_features = 100;
   int num_heading_features = 100;
   std::uint64_t seed = 1;
   double segment_length = 0.0;   // Seconds; 0: one global segment.
   double segment_overlap = 0.0;  // Seconds, < segment_length.
+  // Capacity rule: the standard deviation of the motion the basis misses
+  // (the square root of the kernel's spectral mass beyond its bandwidth;
+  // other families: of the max kernel error), metres and radians.
+  double capacity_position_sigma = 0.05;
+  double capacity_heading_sigma = 0.005;
 };
+
+inline constexpr int kAutoCapacity = 0;
+inline constexpr int kMaxAutoFeatures = 512;
+
+// Capacity from the data's time scale rather than a constant: with
+// num_position_features == kAutoCapacity, segments of kSegmentLengthscales
+// position lengthscales (one global map when the run is shorter than 1.5 of
+// them), blended over kOverlapLengthscales, and per segment the smallest D
+// whose missed spectral mass is below the tolerance (HilbertNumFeatures).
+// Returns the options with those values filled in.
+FeatureTrajectoryOptions AutoCapacity(const FeatureTrajectoryOptions& options,
+                                      double duration);
 
 class FeatureTrajectory : public TrajectoryModel {
  public:
@@ -67,6 +86,8 @@ class FeatureTrajectory : public TrajectoryModel {
   void AddPriorCosts(ceres::Problem* problem, int begin, int end) override;
 
   double origin() const { return origin_; }
+  // The options with the capacity settled (see AutoCapacity).
+  const FeatureTrajectoryOptions& options() const { return options_; }
   const MeanFunction& mean() const override { return *mean_; }
   void set_mean(std::shared_ptr<const MeanFunction> mean) override {
     mean_ = std::move(mean);
@@ -88,6 +109,7 @@ class FeatureTrajectory : public TrajectoryModel {
   };
   const std::vector<Features>& FeaturesAt(double t) const;
 
+  FeatureTrajectoryOptions options_;
   std::shared_ptr<const MeanFunction> mean_;
   std::unique_ptr<Kernel> position_kernel_, heading_kernel_;
   std::vector<Segment> segments_;

@@ -38,6 +38,16 @@ bool CreateLoss(const LossOptions& options,
   return true;
 }
 
+ceres::LinearSolverType AutoLinearSolverType(const TrajectoryModel& model) {
+  int trajectory_parameters = 0;
+  for (int b = 0; b < model.num_blocks(); ++b) {
+    trajectory_parameters += model.block_size(b);
+  }
+  return trajectory_parameters <= kMaxDenseReducedSystem
+             ? ceres::DENSE_SCHUR
+             : ceres::SPARSE_NORMAL_CHOLESKY;
+}
+
 SlamProblem::SlamProblem(TrajectoryModel* model, const ProblemOptions& options)
     : model_(model), options_(options) {
   ceres::Problem::Options problem_options;
@@ -48,16 +58,7 @@ SlamProblem::SlamProblem(TrajectoryModel* model, const ProblemOptions& options)
 
 std::vector<double*> SlamProblem::LocalBlocks(std::vector<PoseMap*> maps,
                                               double* landmark) {
-  std::vector<double*> blocks;
-  std::map<int, int> local;  // Model block id -> index in `blocks`.
-  for (PoseMap* map : maps) {
-    for (PoseTerm& term : map->terms) {
-      auto [it, inserted] =
-          local.emplace(term.block, static_cast<int>(blocks.size()));
-      if (inserted) blocks.push_back(model_->mutable_block(term.block));
-      term.block = it->second;
-    }
-  }
+  std::vector<double*> blocks = BindPoseMaps(model_, maps);
   if (landmark != nullptr) blocks.push_back(landmark);
   return blocks;
 }

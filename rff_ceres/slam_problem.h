@@ -57,6 +57,13 @@ struct ProblemOptions {
   double max_preintegration_seconds = 1.0;
 };
 
+// The linear solver of "auto": DENSE_SCHUR when the reduced system (every
+// trajectory parameter after the landmarks are eliminated) has at most
+// kMaxDenseReducedSystem unknowns, else SPARSE_NORMAL_CHOLESKY, whose
+// fill-reducing ordering handles landmarks seen from the whole run.
+inline constexpr int kMaxDenseReducedSystem = 2000;
+ceres::LinearSolverType AutoLinearSolverType(const TrajectoryModel& model);
+
 class SlamProblem {
  public:
   // `model` must outlive the problem; its blocks are the problem's.

@@ -8,6 +8,7 @@
 
 #include "ceres/types.h"
 #include "glog/logging.h"
+#include "rff_ceres/initialization.h"
 #include "rff_ceres/io/text_parser.h"
 #include "rff_ceres/landmark_init.h"
 #include "rff_ceres/mean/prior_mean.h"
@@ -49,11 +50,14 @@ class ProgressLogger : public ceres::IterationCallback {
 
 bool ToCeresOptions(const SolverOptions& options,
                     ceres::Solver::Options* ceres_options, std::string* error) {
-  std::string name = options.linear_solver;
+  // "auto" is settled per problem by ChooseLinearSolver; until then the
+  // sparse Cholesky, whose options are always valid.
+  std::string name = options.linear_solver == "auto" ? "SPARSE_NORMAL_CHOLESKY"
+                                                     : options.linear_solver;
   if (!ceres::StringToLinearSolverType(name,
                                        &ceres_options->linear_solver_type)) {
     *error = "unknown linear solver '" + options.linear_solver +
-             "' (DENSE_SCHUR, SPARSE_SCHUR, ITERATIVE_SCHUR, DENSE_QR, "
+             "' (auto, DENSE_SCHUR, SPARSE_SCHUR, ITERATIVE_SCHUR, DENSE_QR, "
              "DENSE_NORMAL_CHOLESKY, SPARSE_NORMAL_CHOLESKY, CGNR)";
     return false;
   }
@@ -157,6 +161,30 @@ std::unique_ptr<TrajectoryModel> CreateTrajectoryModel(
 
 namespace {
 
+// "auto" settles on AutoLinearSolverType; an explicit choice is obeyed.
+void ChooseLinearSolver(const SolverOptions& solver,
+                        const TrajectoryModel& model,
+                        ceres::Solver::Options* options, SlamResult* result) {
+  if (solver.linear_solver != "auto") {
+    result->linear_solver = solver.linear_solver;
+    result->linear_solver_reason = "as asked";
+    return;
+  }
+  int trajectory_parameters = 0;
+  for (int b = 0; b < model.num_blocks(); ++b) {
+    trajectory_parameters += model.block_size(b);
+  }
+  options->linear_solver_type = AutoLinearSolverType(model);
+  const bool dense = options->linear_solver_type == ceres::DENSE_SCHUR;
+  result->linear_solver =
+      ceres::LinearSolverTypeToString(options->linear_solver_type);
+  result->linear_solver_reason =
+      std::to_string(trajectory_parameters) + " trajectory parameters " +
+      (dense ? "<= " : "> ") + std::to_string(kMaxDenseReducedSystem) +
+      (dense ? ": the reduced system is small and dense"
+             : ": sparse factorisation of the whole system");
+}
+
 // Schur solvers eliminate the landmarks first. The others get no ordering:
 // their fill-reducing ordering (AMD) puts landmarks seen from the whole run
 // last, where eliminating them first would make the system dense (the WNOA
@@ -241,6 +269,7 @@ bool SolveBatch(const Dataset& dataset, const SlamOptions& options,
     *problem = std::make_unique<SlamProblem>(model, options.problem);
     (*problem)->set_range_calibration(result->range_calibration);
     if (!(*problem)->Build(dataset, *landmarks, error)) return false;
+    ChooseLinearSolver(options.solver, *model, &ceres_options, result);
     SetOrdering(problem->get(), &ceres_options);
     ceres::Solve(ceres_options, (*problem)->problem(), &result->summary);
     VLOG(1) << result->summary.FullReport();
@@ -287,6 +316,7 @@ bool SolveIncremental(const Dataset& dataset, const SlamOptions& options,
   for (const Observation& o : dataset.observations) ids.push_back(o.id);
   if (!slam.Begin(ids, error)) return false;
   ceres::Problem* ceres_problem = slam.problem();
+  ChooseLinearSolver(options.solver, *model, &ceres_options, result);
 
   // Newest time each trajectory block has been touched at (-inf: never).
   std::vector<double> touched(model->num_blocks(),
@@ -411,6 +441,30 @@ bool SolveIncremental(const Dataset& dataset, const SlamOptions& options,
   return true;
 }
 
+// The blocks start at the fit of the pilot trajectory when there is one
+// (initial_trajectory "auto"), else at zero (the prior mean).
+bool InitializeBlocks(const Dataset& start, const SlamOptions& options,
+                      TrajectoryModel* model, SlamResult* result,
+                      std::string* error) {
+  result->initial_trajectory = "mean";
+  if (options.initial_trajectory == "mean") return true;
+  if (options.initial_trajectory != "auto") {
+    *error = "unknown initial trajectory '" + options.initial_trajectory +
+             "' (expected auto or mean)";
+    return false;
+  }
+  std::vector<TimedPose> pilot;
+  std::string why;
+  if (!BuildPilotTrajectory(start, options.localization, OutputTimes(start),
+                            &pilot, &why)) {
+    VLOG(1) << "no pilot trajectory, starting from the mean: " << why;
+    return true;
+  }
+  if (!FitModelToPoses(pilot, model, error)) return false;
+  result->initial_trajectory = "localization";
+  return true;
+}
+
 }  // namespace
 
 bool RunSlam(const Dataset& dataset, const SlamOptions& options,
@@ -419,6 +473,13 @@ bool RunSlam(const Dataset& dataset, const SlamOptions& options,
   *result = SlamResult();
   ceres::Solver::Options ceres_options;
   if (!ToCeresOptions(options.solver, &ceres_options, error)) return false;
+  if (options.learn_hyperparameters != "auto" &&
+      options.learn_hyperparameters != "on" &&
+      options.learn_hyperparameters != "off") {
+    *error = "learn_hyperparameters must be auto, on or off, got '" +
+             options.learn_hyperparameters + "'";
+    return false;
+  }
   if (options.outer_rounds < 0) {
     *error = "outer_rounds must be >= 0, got " +
              std::to_string(options.outer_rounds);
@@ -453,19 +514,25 @@ bool RunSlam(const Dataset& dataset, const SlamOptions& options,
     return false;
   }
 
+  // The start (heading, pilot) may come from the data; the prior may not.
+  const Dataset resolved = ResolveStartHeading(dataset, &result->start_heading);
   std::shared_ptr<const MeanFunction> mean =
-      BuildPriorMean(options.prior_mean, dataset, options.localization, error);
+      BuildPriorMean(options.prior_mean, resolved, options.localization, error);
   if (!mean) return false;
   std::unique_ptr<TrajectoryModel> model =
       CreateTrajectoryModel(dataset, options, mean, error);
   if (!model) return false;
+  if (!InitializeBlocks(resolved, options, model.get(), result, error)) {
+    return false;
+  }
 
-  // The initial scene: the prior mean, the landmarks' initial positions and
-  // the longest range, to tell a run-away solution from a large scene.
+  // The initial scene: the initial trajectory, the landmarks' initial
+  // positions and the longest range, to tell a run-away solution from a
+  // large scene.
   std::map<LandmarkId, Eigen::Vector2d> landmarks;
   if (incremental.every == 0 &&
       !InitializeLandmarks(
-          dataset, [&](double t) { return mean->Evaluate(t); }, &landmarks,
+          resolved, [&](double t) { return model->Pose(t); }, &landmarks,
           error)) {
     return false;
   }
@@ -473,6 +540,32 @@ bool RunSlam(const Dataset& dataset, const SlamOptions& options,
   for (const double t : OutputTimes(dataset)) {
     const Eigen::Vector3d pose = model->Pose(t);
     initial.push_back({t, pose.x(), pose.y(), pose.z()});
+  }
+  SlamOptions settled = options;
+  const bool search =
+      options.learn_hyperparameters == "on" ||
+      (options.learn_hyperparameters == "auto" && dataset.odometry.empty());
+  if (options.prior == "rff" && options.learn_hyperparameters == "auto" &&
+      !search && result->initial_trajectory == "localization") {
+    // Drift of dead reckoning: its size from the pilot, its time scale given.
+    MatchVariancesToSpread(*mean, initial, &settled.trajectory);
+    model = CreateTrajectoryModel(dataset, settled, mean, error);
+    if (!model || !FitModelToPoses(initial, model.get(), error)) return false;
+  }
+  if (options.prior == "rff" && incremental.every == 0 && search) {
+    if (!LearnHyperparameters(resolved, mean, initial, landmarks,
+                              options.problem, options.learning,
+                              &settled.trajectory, &result->learning, error)) {
+      *error = "learning the hyperparameters: " + *error;
+      return false;
+    }
+    result->learned = true;
+    model = CreateTrajectoryModel(dataset, settled, mean, error);
+    if (!model || !FitModelToPoses(initial, model.get(), error)) return false;
+  }
+  if (const auto* features =
+          dynamic_cast<const FeatureTrajectory*>(model.get())) {
+    result->trajectory_options = features->options();
   }
   double initial_extent = Extent(initial, landmarks);
   for (const LandmarkPrior& p : dataset.landmark_priors) {
@@ -490,13 +583,13 @@ bool RunSlam(const Dataset& dataset, const SlamOptions& options,
   if (options.solver.log_progress) ceres_options.callbacks.push_back(&progress);
   std::unique_ptr<SlamProblem> problem;
   if (incremental.every > 0) {
-    if (!SolveIncremental(dataset, options, ceres_options, model.get(),
+    if (!SolveIncremental(dataset, settled, ceres_options, model.get(),
                           &landmarks, &problem, result, error) ||
         !CollectTrajectory(dataset, *model, landmarks, initial_extent, result,
                            error)) {
       return false;
     }
-  } else if (!SolveBatch(dataset, options, ceres_options, model.get(),
+  } else if (!SolveBatch(dataset, settled, ceres_options, model.get(),
                          &landmarks, initial_extent, &problem, result, error)) {
     return false;
   }
@@ -543,7 +636,7 @@ void UpdateTimes(const SlamResult& result, double* mean, double* max) {
 void PrintSlamSummary(const SlamOptions& options, const SlamResult& result,
                       std::ostream* out) {
   const ceres::Solver::Summary& s = result.summary;
-  const FeatureTrajectoryOptions& t = options.trajectory;
+  const FeatureTrajectoryOptions& t = result.trajectory_options;
   if (options.prior == "wnoa") {
     *out << "  model        WNOA (LTV-SDE) prior, Q_c = "
          << options.wnoa.position_qc << " (x, y), " << options.wnoa.heading_qc
@@ -553,15 +646,40 @@ void PrintSlamSummary(const SlamOptions& options, const SlamResult& result,
          << t.position_kernel.name << " kernel, D = " << t.num_position_features
          << " (x, y), " << t.num_heading_features << " (theta), "
          << options.prior_mean << " mean\n";
+    *out << "  kernels      lengthscale " << t.position_kernel.lengthscale
+         << " s, variance " << t.position_kernel.variance
+         << " (x, y); lengthscale " << t.heading_kernel.lengthscale
+         << " s, variance " << t.heading_kernel.variance << " (theta)";
+    if (t.segment_length > 0.0) {
+      *out << "; segments of " << t.segment_length << " s blended over "
+           << t.segment_overlap << " s";
+    }
+    *out << "\n";
+    if (result.learned) {
+      *out << "  learned      by the Laplace evidence on the first "
+           << result.learning.window_end - result.trajectory.front().t
+           << " s: log evidence " << result.learning.log_evidence << ", "
+           << result.learning.evaluations << " solves, "
+           << result.learning.seconds << " s\n";
+    }
   }
   *out << "  problem      " << s.num_residual_blocks << " residual blocks, "
        << s.num_parameters << " parameters\n"
-       << "  solver       " << options.solver.linear_solver << ", "
+       << "  solver       " << options.solver.linear_solver << " -> "
+       << result.linear_solver << " (" << result.linear_solver_reason << "), "
        << result.total_iterations << " iterations, "
        << ceres::TerminationTypeToString(s.termination_type) << "\n"
        << "  cost         " << s.initial_cost << " -> " << s.final_cost << "\n"
        << "  time         " << s.total_time_in_seconds << " s in Ceres, "
        << result.solve_seconds << " s total\n";
+  *out << "  start        initial trajectory from the "
+       << result.initial_trajectory;
+  if (result.start_heading.resolved) {
+    *out << "; start heading unknown, resolved to "
+         << result.start_heading.heading << " rad (prior "
+         << result.start_heading.prior_heading << ")";
+  }
+  *out << "\n";
   if (options.problem.range_calibration.estimate) {
     *out << "  range model  " << result.range_calibration[0] << " * distance + "
          << result.range_calibration[1] << " m\n";
@@ -584,7 +702,7 @@ bool WriteSummaryJson(const SlamOptions& options, const SlamResult& result,
   std::ofstream out;
   if (!OpenForWriting(path, &out, error)) return false;
   const ceres::Solver::Summary& s = result.summary;
-  const FeatureTrajectoryOptions& t = options.trajectory;
+  const FeatureTrajectoryOptions& t = result.trajectory_options;
   double update_mean, update_max;
   UpdateTimes(result, &update_mean, &update_max);
   out << "{\n"
@@ -595,6 +713,19 @@ bool WriteSummaryJson(const SlamOptions& options, const SlamResult& result,
       << "  \"lengthscale\": " << FormatNumber(t.position_kernel.lengthscale)
       << ",\n"
       << "  \"kernel_variance\": " << FormatNumber(t.position_kernel.variance)
+      << ",\n"
+      << "  \"heading_lengthscale\": "
+      << FormatNumber(t.heading_kernel.lengthscale) << ",\n"
+      << "  \"heading_kernel_variance\": "
+      << FormatNumber(t.heading_kernel.variance) << ",\n"
+      << "  \"segment_length\": " << FormatNumber(t.segment_length) << ",\n"
+      << "  \"segment_overlap\": " << FormatNumber(t.segment_overlap) << ",\n"
+      << "  \"learn_hyperparameters\": " << (result.learned ? "true" : "false")
+      << ",\n"
+      << "  \"log_evidence\": " << FormatNumber(result.learning.log_evidence)
+      << ",\n"
+      << "  \"learning_solves\": " << result.learning.evaluations << ",\n"
+      << "  \"learning_seconds\": " << FormatNumber(result.learning.seconds)
       << ",\n"
       << "  \"features\": " << JsonString(t.family) << ",\n"
       << "  \"num_features\": " << t.num_position_features << ",\n"
@@ -607,8 +738,9 @@ bool WriteSummaryJson(const SlamOptions& options, const SlamResult& result,
       << "  \"loss\": " << JsonString(options.problem.loss.name) << ",\n"
       << "  \"odometry_loss\": "
       << JsonString(options.problem.odometry_loss.name) << ",\n"
-      << "  \"linear_solver\": " << JsonString(options.solver.linear_solver)
-      << ",\n"
+      << "  \"linear_solver\": " << JsonString(result.linear_solver) << ",\n"
+      << "  \"linear_solver_reason\": "
+      << JsonString(result.linear_solver_reason) << ",\n"
       << "  \"termination\": "
       << JsonString(ceres::TerminationTypeToString(s.termination_type)) << ",\n"
       << "  \"converged\": " << (result.converged ? "true" : "false") << ",\n"
@@ -623,6 +755,12 @@ bool WriteSummaryJson(const SlamOptions& options, const SlamResult& result,
       << "  \"total_seconds\": " << FormatNumber(result.solve_seconds) << ",\n"
       << "  \"num_poses\": " << result.trajectory.size() << ",\n"
       << "  \"num_landmarks\": " << result.landmarks.size() << ",\n"
+      << "  \"initial_trajectory\": " << JsonString(result.initial_trajectory)
+      << ",\n"
+      << "  \"start_heading_resolved\": "
+      << (result.start_heading.resolved ? "true" : "false") << ",\n"
+      << "  \"start_heading\": " << FormatNumber(result.start_heading.heading)
+      << ",\n"
       << "  \"range_scale\": " << FormatNumber(result.range_calibration[0])
       << ",\n"
       << "  \"range_offset\": " << FormatNumber(result.range_calibration[1])

@@ -13,6 +13,8 @@
 #include "Eigen/Core"
 #include "ceres/solver.h"
 #include "rff_ceres/feature_trajectory.h"
+#include "rff_ceres/hyperparameter_learning.h"
+#include "rff_ceres/initialization.h"
 #include "rff_ceres/mean/localization_mean.h"
 #include "rff_ceres/slam_problem.h"
 #include "rff_ceres/types.h"
@@ -22,7 +24,9 @@ namespace rff {
 
 // Ceres solver settings, named as Ceres names them.
 struct SolverOptions {
-  std::string linear_solver = "DENSE_SCHUR";
+  // "auto" (chosen from the problem's structure, see slam_solver.cc) or a
+  // Ceres linear solver name.
+  std::string linear_solver = "auto";
   std::string preconditioner = "auto";  // Or a Ceres preconditioner name.
   std::string trust_region_strategy = "LEVENBERG_MARQUARDT";
   // 1: reproducible to the bit; more threads sum in scheduling order.
@@ -53,9 +57,19 @@ struct SlamOptions {
   // "wnoa" (LTV-SDE states, WnoaTrajectory).
   std::string prior = "rff";
   std::string prior_mean = "auto";
+  // Initial value of the blocks: "auto" fits them to a localisation pilot
+  // (initialization.h) when one can be built; "mean" starts at the mean.
+  std::string initial_trajectory = "auto";
   // Tuning of the "localization" mean (docs/prior_means.md).
   LocalizationOptions localization;
   FeatureTrajectoryOptions trajectory;
+  // Learn the RFF kernels' lengthscales and variances (batch mode), starting
+  // from `trajectory`'s (hyperparameter_learning.h): "on", "off", or "auto",
+  // on for data without odometry. With odometry the GP models the drift of
+  // dead reckoning, which grows along the run: a stationary kernel learned
+  // on a window misjudges it (docs/hyperparameters.md has the measurements).
+  std::string learn_hyperparameters = "auto";
+  LearningOptions learning;
   WnoaOptions wnoa;
   ProblemOptions problem;
   SolverOptions solver;
@@ -91,6 +105,15 @@ struct SlamResult {
   double solve_seconds = 0.0;              // Wall time of the whole RunSlam.
   bool converged = false;                  // Ceres reported CONVERGENCE.
   std::vector<IncrementalUpdate> updates;  // Incremental mode only.
+  StartHeading start_heading;
+  // The RFF model as solved: learned kernels, settled capacity.
+  FeatureTrajectoryOptions trajectory_options;
+  bool learned = false;
+  LearningReport learning;
+  // The linear solver used and why ("auto" settles on one per problem).
+  std::string linear_solver;
+  std::string linear_solver_reason;
+  std::string initial_trajectory;  // "localization" (the pilot) or "mean".
   // (scale, offset) of the range sensor; (1, 0) unless estimated.
   Eigen::Vector2d range_calibration = Eigen::Vector2d(1.0, 0.0);
 };

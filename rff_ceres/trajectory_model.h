@@ -50,6 +50,11 @@ class TrajectoryModel {
   Eigen::Vector3d Pose(double t) const;
 };
 
+// The parameter blocks a cost over `maps` takes, in order of first use; the
+// maps' model block ids are rewritten to indices into that list, in place.
+std::vector<double*> BindPoseMaps(TrajectoryModel* model,
+                                  const std::vector<PoseMap*>& maps);
+
 }  // namespace rff
 
 #endif  // RFF_CERES_TRAJECTORY_MODEL_H_

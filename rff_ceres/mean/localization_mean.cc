@@ -12,23 +12,16 @@
 #include "rff_ceres/mean/spline_mean.h"
 
 namespace rff {
-namespace {
 
-constexpr double kUnmeasuredHeadingVariance = 1e6;
-
-// One whitened residual row over the unknowns (x, y, theta).
-struct Row {
-  double residual = 0.0;
-  Eigen::RowVector3d jacobian = Eigen::RowVector3d::Zero();
-};
-
-// Whitened residuals of `observations` at pose `p`.
-std::vector<Row> Residuals(const std::vector<Observation>& observations,
-                           const std::map<LandmarkId, KnownLandmark>& landmarks,
-                           const Eigen::Vector3d& p) {
-  std::vector<Row> rows;
+std::vector<MapResidualRow> MapResiduals(
+    const std::vector<Observation>& observations,
+    const std::map<LandmarkId, KnownLandmark>& landmarks,
+    const Eigen::Vector3d& p) {
+  std::vector<MapResidualRow> rows;
   for (const Observation& o : observations) {
-    const KnownLandmark& l = landmarks.at(o.id);
+    const auto known = landmarks.find(o.id);
+    if (known == landmarks.end()) continue;
+    const KnownLandmark& l = known->second;
     // The measurement models of the solver's costs (costs/range_cost.h,
     // costs/bearing_cost.h), with the landmark's prior spread added.
     double range;
@@ -38,7 +31,7 @@ std::vector<Row> Residuals(const std::vector<Observation>& observations,
     if (o.HasRange()) {
       const double sigma =
           std::sqrt(o.sigma_range * o.sigma_range + l.sigma * l.sigma);
-      Row row;
+      MapResidualRow row;
       row.residual = (range - o.range) / sigma;
       row.jacobian = d_pose.transpose() / sigma;
       rows.push_back(row);
@@ -49,7 +42,7 @@ std::vector<Row> Residuals(const std::vector<Observation>& observations,
       const double spread = l.sigma / std::max(range, 1e-6);
       const double sigma =
           std::sqrt(o.sigma_bearing * o.sigma_bearing + spread * spread);
-      Row row;
+      MapResidualRow row;
       row.residual = WrapAngle(bearing - o.bearing) / sigma;
       row.jacobian = d_pose.transpose() / sigma;
       rows.push_back(row);
@@ -58,9 +51,13 @@ std::vector<Row> Residuals(const std::vector<Observation>& observations,
   return rows;
 }
 
-double Cost(const std::vector<Row>& rows) {
+namespace {
+
+constexpr double kUnmeasuredHeadingVariance = 1e6;
+
+double Cost(const std::vector<MapResidualRow>& rows) {
   double cost = 0.0;
-  for (const Row& r : rows) cost += r.residual * r.residual;
+  for (const MapResidualRow& r : rows) cost += r.residual * r.residual;
   return cost;
 }
 
@@ -70,13 +67,14 @@ double Refine(const std::vector<Observation>& observations,
               const std::map<LandmarkId, KnownLandmark>& landmarks,
               bool free_heading, Eigen::Vector3d* pose) {
   const int n = free_heading ? 3 : 2;
-  std::vector<Row> rows = Residuals(observations, landmarks, *pose);
+  std::vector<MapResidualRow> rows =
+      MapResiduals(observations, landmarks, *pose);
   double cost = Cost(rows);
   double lambda = 1e-3;
   for (int iteration = 0; iteration < 50; ++iteration) {
     Eigen::Matrix3d h = Eigen::Matrix3d::Zero();
     Eigen::Vector3d g = Eigen::Vector3d::Zero();
-    for (const Row& r : rows) {
+    for (const MapResidualRow& r : rows) {
       h += r.jacobian.transpose() * r.jacobian;
       g += r.jacobian.transpose() * r.residual;
     }
@@ -87,7 +85,8 @@ double Refine(const std::vector<Observation>& observations,
     Eigen::Vector3d candidate = *pose;
     candidate.head(n) += step;
     if (!candidate.allFinite()) break;
-    const std::vector<Row> next = Residuals(observations, landmarks, candidate);
+    const std::vector<MapResidualRow> next =
+        MapResiduals(observations, landmarks, candidate);
     const double next_cost = Cost(next);
     if (next_cost < cost) {
       const bool small = cost - next_cost < 1e-12 * (1.0 + cost) ||
@@ -158,7 +157,7 @@ bool LocalizePose(const std::vector<Observation>& observations,
   // Information of the free unknowns; a degenerate geometry (collinear
   // landmarks, parallel bearings) leaves it singular.
   Eigen::Matrix3d h = Eigen::Matrix3d::Zero();
-  for (const Row& r : Residuals(usable, landmarks, best)) {
+  for (const MapResidualRow& r : MapResiduals(usable, landmarks, best)) {
     h += r.jacobian.transpose() * r.jacobian;
   }
   const Eigen::MatrixXd hn = h.topLeftCorner(unknowns, unknowns);

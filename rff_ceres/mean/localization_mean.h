@@ -25,6 +25,21 @@ struct KnownLandmark {
   double sigma = 0.0;
 };
 
+// One whitened residual row of an observation against a known landmark, over
+// the unknowns (x, y, theta).
+struct MapResidualRow {
+  double residual = 0.0;
+  Eigen::RowVector3d jacobian = Eigen::RowVector3d::Zero();
+};
+
+// Whitened residuals of `observations` (landmarks missing from `landmarks`
+// are skipped) at pose `p`: the measurement models of the solver's costs with
+// the landmark's spread added (sigma_r^2 + s^2; sigma_b^2 + (s / r)^2).
+std::vector<MapResidualRow> MapResiduals(
+    const std::vector<Observation>& observations,
+    const std::map<LandmarkId, KnownLandmark>& landmarks,
+    const Eigen::Vector3d& p);
+
 // One localisation: pose at time t and its covariance (x, y, theta). When the
 // measurements carry no heading (range-only), has_heading is false and the
 // heading is that of the seed.

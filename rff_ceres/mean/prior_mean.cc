@@ -59,15 +59,10 @@ std::shared_ptr<const MeanFunction> BuildPriorMean(
     *error = "prior mean '" + name + "': the dataset has no PRIOR_POSE record";
     return nullptr;
   }
+  // From the inputs only: observations in the mean would count twice.
   if (name == "auto") {
-    if (!dataset.odometry.empty()) {
-      return BuildPriorMean("odometry", dataset, localization, error);
-    }
-    std::string ignored;
-    std::shared_ptr<const MeanFunction> mean =
-        BuildPriorMean("localization", dataset, localization, &ignored);
-    return mean ? mean
-                : BuildPriorMean("constant", dataset, localization, error);
+    return BuildPriorMean(dataset.odometry.empty() ? "constant" : "odometry",
+                          dataset, localization, error);
   }
   if (name == "constant") {
     return std::make_shared<PiecewiseLinearMean>(

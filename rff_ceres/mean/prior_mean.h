@@ -24,8 +24,9 @@ std::vector<std::string> PriorMeanNames();
 // "spline": a smoothing spline (p = 0.98) through the "auto" mean at the
 //   observation times, the first round of the paper's III-B.2.
 // "constant": the earliest PRIOR_POSE at every time.
-// "auto": odometry if the dataset has ODOM records, else localization if
-//   some time can be localised, else constant.
+// "auto": odometry if the dataset has ODOM records, else constant: the mean
+//   comes from the inputs only (the observations enter as residuals; a
+//   localisation of them is the solver's initial value, not its mean).
 // "localization" (also through "auto" and "spline") uses `localization`.
 std::shared_ptr<const MeanFunction> BuildPriorMean(
     const std::string& name, const Dataset& dataset,

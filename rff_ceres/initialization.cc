@@ -1,0 +1,187 @@
+#include "rff_ceres/initialization.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <memory>
+
+#include "Eigen/Geometry"
+#include "ceres/problem.h"
+#include "ceres/solver.h"
+#include "costs/pose_prior_cost.h"
+#include "rff_ceres/dead_reckoning.h"
+#include "rff_ceres/se2.h"
+
+namespace rff {
+namespace {
+
+// Candidate start headings of the scan; the refinement then searches the
+// best cell, so the scan only has to land in the right basin.
+constexpr int kHeadingCandidates = 72;
+// Cauchy scale of the heading score (whitened units): far-off residuals of a
+// wrong heading saturate instead of dominating.
+constexpr double kScoreLossScale = 2.0;
+// Sigmas of the pilot fit: tighter than any pilot is accurate, looser than
+// the model's feature resolution, so the fit follows the pilot's shape.
+constexpr double kFitSigmaXy = 0.05;
+constexpr double kFitSigmaTheta = 0.05;
+
+PosePrior* EarliestPrior(Dataset* dataset) {
+  return &*std::min_element(dataset->pose_priors.begin(),
+                            dataset->pose_priors.end(),
+                            [](const PosePrior& a, const PosePrior& b) {
+                              return a.pose.t < b.pose.t;
+                            });
+}
+
+// Observations grouped by time with the dead-reckoned pose there, for
+// scoring rotations of the dead reckoning about its start.
+struct ScoredTime {
+  Eigen::Vector3d pose;
+  std::vector<Observation> observations;
+};
+
+// Sum of Cauchy(whitened residual) of the observations when dead reckoning
+// is rotated by `rotation` about the start position.
+double HeadingCost(const std::vector<ScoredTime>& times,
+                   const Eigen::Vector2d& start,
+                   const std::map<LandmarkId, KnownLandmark>& landmarks,
+                   double rotation) {
+  const Eigen::Rotation2Dd r(rotation);
+  const double c2 = kScoreLossScale * kScoreLossScale;
+  double cost = 0.0;
+  for (const ScoredTime& s : times) {
+    Eigen::Vector3d pose;
+    pose << start + r * (s.pose.head<2>() - start), s.pose.z() + rotation;
+    for (const MapResidualRow& row :
+         MapResiduals(s.observations, landmarks, pose)) {
+      cost += std::log1p(row.residual * row.residual / c2);
+    }
+  }
+  return cost;
+}
+
+}  // namespace
+
+Dataset ResolveStartHeading(const Dataset& dataset, StartHeading* report) {
+  *report = StartHeading();
+  Dataset resolved = dataset;
+  if (resolved.pose_priors.empty() || resolved.odometry.empty() ||
+      resolved.landmark_priors.empty()) {
+    return resolved;
+  }
+  PosePrior* first = EarliestPrior(&resolved);
+  report->prior_heading = report->heading = first->pose.theta;
+  if (!(first->sigma_theta > kLooseHeadingSigma)) return resolved;
+
+  DeadReckoningResult dr;
+  DeadReckoningOptions dr_options;
+  dr_options.hold_through_gaps = true;
+  std::string ignored;
+  if (!DeadReckon(resolved, dr_options, &dr, &ignored)) return resolved;
+  std::map<LandmarkId, KnownLandmark> landmarks;
+  for (const LandmarkPrior& l : resolved.landmark_priors) {
+    landmarks[l.id] = {Eigen::Vector2d(l.x, l.y), l.sigma};
+  }
+  std::map<double, ScoredTime> by_time;
+  for (const Observation& o : resolved.observations) {
+    if (landmarks.count(o.id) == 0) continue;
+    ScoredTime& s = by_time[o.t];
+    if (s.observations.empty()) {
+      const TimedPose p = PoseAtTime(dr.poses, o.t);
+      s.pose << p.x, p.y, p.theta;
+    }
+    s.observations.push_back(o);
+  }
+  if (by_time.empty()) return resolved;
+  std::vector<ScoredTime> times;
+  for (auto& [t, s] : by_time) times.push_back(std::move(s));
+  const Eigen::Vector2d start(first->pose.x, first->pose.y);
+  auto cost = [&](double rotation) {
+    return HeadingCost(times, start, landmarks, rotation);
+  };
+
+  const double cell = 2.0 * M_PI / kHeadingCandidates;
+  double best = 0.0, best_cost = cost(0.0);
+  report->prior_cost = best_cost;
+  for (int k = 1; k < kHeadingCandidates; ++k) {
+    const double c = cost(k * cell);
+    if (c < best_cost) {
+      best = k * cell;
+      best_cost = c;
+    }
+  }
+  // Golden-section search over the best candidate's neighbourhood.
+  const double ratio = 0.5 * (std::sqrt(5.0) - 1.0);
+  double a = best - cell, b = best + cell;
+  double x1 = b - ratio * (b - a), x2 = a + ratio * (b - a);
+  double f1 = cost(x1), f2 = cost(x2);
+  while (b - a > 1e-4) {
+    if (f1 < f2) {
+      b = x2, x2 = x1, f2 = f1;
+      x1 = b - ratio * (b - a), f1 = cost(x1);
+    } else {
+      a = x1, x1 = x2, f1 = f2;
+      x2 = a + ratio * (b - a), f2 = cost(x2);
+    }
+  }
+  const double refined = 0.5 * (a + b);
+  const double refined_cost = cost(refined);
+  if (refined_cost < best_cost) {
+    best = refined;
+    best_cost = refined_cost;
+  }
+  first->pose.theta = WrapAngle(first->pose.theta + best);
+  report->resolved = true;
+  report->heading = first->pose.theta;
+  report->cost = best_cost;
+  return resolved;
+}
+
+bool BuildPilotTrajectory(const Dataset& dataset,
+                          const LocalizationOptions& localization,
+                          const std::vector<double>& times,
+                          std::vector<TimedPose>* pilot, std::string* why) {
+  pilot->clear();
+  LocalizationReport report;
+  const std::shared_ptr<const MeanFunction> localized =
+      BuildLocalizationMean(dataset, localization, &report, why);
+  if (!localized) return false;
+  for (const double t : times) {
+    const Eigen::Vector3d p = localized->Evaluate(t);
+    pilot->push_back({t, p.x(), p.y(), p.z()});
+  }
+  return true;
+}
+
+bool FitModelToPoses(const std::vector<TimedPose>& poses,
+                     TrajectoryModel* model, std::string* error) {
+  ceres::Problem problem;
+  for (int b = 0; b < model->num_blocks(); ++b) {
+    problem.AddParameterBlock(model->mutable_block(b), model->block_size(b));
+  }
+  model->AddPriorCosts(&problem);
+  const Eigen::Vector3d sigma(kFitSigmaXy, kFitSigmaXy, kFitSigmaTheta);
+  for (const TimedPose& p : poses) {
+    PoseMap map = model->PoseAt(p.t);
+    const std::vector<double*> blocks = BindPoseMaps(model, {&map});
+    problem.AddResidualBlock(
+        new PosePriorCost(std::move(map), Eigen::Vector3d(p.x, p.y, p.theta),
+                          sigma),
+        nullptr, blocks);
+  }
+  ceres::Solver::Options options;
+  options.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
+  options.max_num_iterations = 20;
+  options.logging_type = ceres::SILENT;
+  ceres::Solver::Summary summary;
+  ceres::Solve(options, &problem, &summary);
+  if (summary.termination_type == ceres::FAILURE ||
+      !std::isfinite(summary.final_cost)) {
+    *error = "fitting the initial trajectory failed: " + summary.message;
+    return false;
+  }
+  return true;
+}
+
+}  // namespace rff
