@@ -1,7 +1,7 @@
 // rff_convert: converts a raw public dataset to .rffd (docs/converters.md).
 //
 //   rff_convert --format=plaza --input=DIR --output=OUT.rffd
-//       [--plaza_calibration=linear|none]
+//       [--plaza_calibration=linear|none] [--plaza_heading_offset=auto|RAD]
 //   rff_convert --format=mrclam --input=DIR --mrclam_robot=N --output=OUT.rffd
 //       [--mrclam_odometry_interval=SECONDS]
 #include <gflags/gflags.h>
@@ -40,6 +40,13 @@ DEFINE_double(plaza_odom_sigma_theta_per_rad, 0.05,
               "ODOM heading sigma per radian turned");
 DEFINE_double(plaza_landmark_prior_sigma, 1.0,
               "PRIOR_LANDMARK sigma at the surveyed beacons [m]; 0: none");
+DEFINE_string(plaza_heading_offset, "auto",
+              "Odometry (DR) heading frame minus the GT heading [rad]; auto: "
+              "the init_heading_offset header of NAME_GT.txt / NAME_DR.txt, "
+              "else measured from the data (nearest multiple of pi/2)");
+DEFINE_double(plaza_heading_offset_tolerance, 0.1,
+              "Largest gap [rad] between the heading offset used and the one "
+              "measured from the GT displacements");
 
 DEFINE_int32(mrclam_robot, 0, "Robot number 1..5");
 DEFINE_double(mrclam_odometry_interval, 0.0,
@@ -106,6 +113,16 @@ bool ConvertPlaza(rff::Dataset* dataset, std::string* error) {
   options.odometry_sigma_theta_per_radian =
       FLAGS_plaza_odom_sigma_theta_per_rad;
   options.landmark_prior_sigma = FLAGS_plaza_landmark_prior_sigma;
+  if (FLAGS_plaza_heading_offset != "auto") {
+    double offset;
+    if (!rff::ParseFiniteDouble(FLAGS_plaza_heading_offset, &offset)) {
+      *error = "--plaza_heading_offset must be auto or a number [rad], got '" +
+               FLAGS_plaza_heading_offset + "'";
+      return false;
+    }
+    options.heading_offset = offset;
+  }
+  options.heading_offset_tolerance = FLAGS_plaza_heading_offset_tolerance;
   if (FLAGS_prior_sigma_xy >= 0.0) {
     options.first_pose_sigma_xy = FLAGS_prior_sigma_xy;
   }
@@ -119,6 +136,11 @@ bool ConvertPlaza(rff::Dataset* dataset, std::string* error) {
       "(%zu out of time order, sorted)\n",
       s.ground_truth_rows, s.odometry_rows, s.range_rows,
       s.ranges_out_of_order);
+  std::printf(
+      "heading offset: odometry frame = GT heading + %.4f rad (%s; measured "
+      "%.4f rad)\n",
+      s.heading_offset, s.heading_offset_source.c_str(),
+      s.measured_heading_offset);
   std::printf(
       "calibration fit r_true ~ a * r + b: a = %.6f, b = %.6f m, inlier "
       "sigma = %.4f m, %zu inliers of %zu (threshold %g m)\n",

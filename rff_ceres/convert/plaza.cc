@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <map>
+#include <optional>
 #include <string_view>
 
 #include "rff_ceres/convert/raw_records.h"
@@ -22,6 +24,31 @@ constexpr double kTimeMatchTolerance = 1e-6;
 // settles in a few.
 constexpr int kMaxCalibrationRounds = 100;
 
+// Header key of the heading offset in the raw files (gpslam's .mat variable
+// of the same name): "# init_heading_offset[rad] = X".
+constexpr std::string_view kHeadingOffsetKey = "init_heading_offset";
+
+// Below this much DR travel the direction of the GT displacements is GPS
+// noise: the heading offset cannot be measured and the DR distances not
+// checked.
+constexpr double kMinMeasuredTravel = 1.0;  // m
+
+// The GT displacement must be this close to the DR distance (as a ratio);
+// outside, the DR distance column is in other units or another convention.
+constexpr double kMinDistanceRatio = 0.5;
+constexpr double kMaxDistanceRatio = 2.0;
+
+// Below this much GT turning (summed |heading change|) the heading
+// increments cannot be compared; above it, DR and GT heading increments
+// must agree with a normalised correlation of at least kMinTurnAgreement
+// (1 on Plaza 1; a flipped sign gives -1, absolute headings ~0).
+constexpr double kMinMeasuredTurning = 2.0 * M_PI;
+constexpr double kMinTurnAgreement = 0.5;
+
+// An angle this close to a multiple of pi/2 is that multiple exactly when
+// rotating the odometry (see AxisExactCosSin).
+constexpr double kAxisSnap = 1e-9;
+
 struct RawRange {
   double t = 0.0;
   LandmarkId beacon = 0;
@@ -32,6 +59,10 @@ struct PlazaRaw {
   std::vector<TimedPose> ground_truth;  // Headings as in the file.
   std::vector<double> odometry_distance;
   std::vector<double> odometry_heading;
+  // Comment lines before the first row (where the heading offset is
+  // declared).
+  std::vector<std::string> ground_truth_header;
+  std::vector<std::string> odometry_header;
   std::map<LandmarkId, std::pair<double, double>> beacons;
   std::vector<RawRange> ranges;  // In file order.
 };
@@ -54,7 +85,7 @@ bool ReadGroundTruth(const std::string& path, PlazaRaw* raw,
         raw->ground_truth.push_back({v[0], v[1], v[2], v[3]});
         return true;
       },
-      error);
+      error, &raw->ground_truth_header);
 }
 
 bool ReadOdometry(const std::string& path, PlazaRaw* raw, std::string* error) {
@@ -84,7 +115,7 @@ bool ReadOdometry(const std::string& path, PlazaRaw* raw, std::string* error) {
         raw->odometry_heading.push_back(v[2]);
         return true;
       },
-      error);
+      error, &raw->odometry_header);
 }
 
 bool ReadBeacons(const std::string& path, PlazaRaw* raw, std::string* error) {
@@ -133,6 +164,204 @@ bool ReadRanges(const std::string& path, PlazaRaw* raw, std::string* error) {
         return true;
       },
       error);
+}
+
+// Reads "init_heading_offset[rad] = X" (or ": X") from the header comments
+// of `path` into `offset`; leaves it alone when the file declares none.
+bool ReadDeclaredHeadingOffset(const std::string& path,
+                               const std::vector<std::string>& header,
+                               std::optional<double>* offset,
+                               std::string* error) {
+  for (const std::string& comment : header) {
+    std::string_view text(comment);
+    const std::size_t at = text.find(kHeadingOffsetKey);
+    if (at == std::string_view::npos) continue;
+    auto fail = [&](const std::string& problem) {
+      *error = path + ": header '#" + comment + "': " + problem;
+      return false;
+    };
+    auto skip_blanks = [&text]() {
+      while (!text.empty() && (text.front() == ' ' || text.front() == '\t')) {
+        text.remove_prefix(1);
+      }
+    };
+    text.remove_prefix(at + kHeadingOffsetKey.size());
+    if (!text.empty() && text.front() == '[') {
+      const std::size_t close = text.find(']');
+      if (close == std::string_view::npos ||
+          text.substr(1, close - 1) != "rad") {
+        return fail("the heading offset must be given in [rad]");
+      }
+      text.remove_prefix(close + 1);
+    }
+    skip_blanks();
+    if (text.empty() || (text.front() != '=' && text.front() != ':')) {
+      return fail("expected '=' after " + std::string(kHeadingOffsetKey));
+    }
+    text.remove_prefix(1);
+    skip_blanks();
+    const std::string_view number = text.substr(0, text.find_first_of(" \t"));
+    double value;
+    if (!ParseFiniteDouble(number, &value)) {
+      return fail("'" + std::string(number) + "' is not a finite number");
+    }
+    if (offset->has_value() && **offset != value) {
+      return fail("declares " + FormatNumber(value) + " after " +
+                  FormatNumber(**offset));
+    }
+    *offset = value;
+  }
+  return true;
+}
+
+// cos and sin of `angle`, exactly 0 and +-1 within kAxisSnap of a multiple
+// of pi/2: axis-aligned frames (offset 0, pi/2, pi) then give ODOM records
+// without 1e-17 residue, and offset 0 reproduces (d, 0) bit for bit.
+void AxisExactCosSin(double angle, double* c, double* s) {
+  const double quarters = std::round(angle / M_PI_2);
+  if (std::abs(angle - quarters * M_PI_2) > kAxisSnap) {
+    *c = std::cos(angle);
+    *s = std::sin(angle);
+    return;
+  }
+  static constexpr double kCos[] = {1.0, 0.0, -1.0, 0.0};
+  static constexpr double kSin[] = {0.0, 1.0, 0.0, -1.0};
+  const int quadrant = static_cast<int>(std::fmod(quarters, 4.0) + 4.0) % 4;
+  *c = kCos[quadrant];
+  *s = kSin[quadrant];
+}
+
+// a * b, but +0 when either is 0 (no "-0" in the written records).
+double Product(double a, double b) {
+  return a == 0.0 || b == 0.0 ? 0.0 : a * b;
+}
+
+// What the GT trajectory says about the DR rows, independent of any frame.
+struct OdometryAgreement {
+  // Direction of the GT displacement k -> k + 1 in the GT pose frame at k,
+  // averaged with weight d_k^2 (arg of sum d_k * z_k): where the odometry
+  // frame points relative to the GT heading. NaN below kMinMeasuredTravel.
+  double heading_offset = std::numeric_limits<double>::quiet_NaN();
+  // |sum d_k * z_k| / sum d_k^2: the GT displacement per DR metre.
+  double distance_ratio = std::numeric_limits<double>::quiet_NaN();
+  // Normalised correlation of the GT and DR heading increments; NaN below
+  // kMinMeasuredTurning.
+  double turn_agreement = std::numeric_limits<double>::quiet_NaN();
+};
+
+OdometryAgreement MeasureOdometryAgreement(const PlazaRaw& raw) {
+  const std::vector<TimedPose>& gt = raw.ground_truth;
+  OdometryAgreement result;
+  double sum_x = 0.0, sum_y = 0.0, sum_d2 = 0.0, travel = 0.0;
+  double sum_gh = 0.0, sum_gg = 0.0, sum_hh = 0.0, turning = 0.0;
+  for (std::size_t k = 0; k < raw.odometry_distance.size(); ++k) {
+    const double d = raw.odometry_distance[k];
+    const double c = std::cos(gt[k].theta), s = std::sin(gt[k].theta);
+    const double ex = gt[k + 1].x - gt[k].x, ey = gt[k + 1].y - gt[k].y;
+    sum_x += d * (c * ex + s * ey);
+    sum_y += d * (-s * ex + c * ey);
+    sum_d2 += d * d;
+    travel += std::abs(d);
+    const double g = WrapAngle(gt[k + 1].theta - gt[k].theta);
+    const double h = WrapAngle(raw.odometry_heading[k]);
+    sum_gh += g * h;
+    sum_gg += g * g;
+    sum_hh += h * h;
+    turning += std::abs(g);
+  }
+  // Overflowing sums (absurd coordinates) measure nothing either.
+  if (travel >= kMinMeasuredTravel && std::isfinite(sum_x + sum_y + sum_d2)) {
+    result.heading_offset = std::atan2(sum_y, sum_x);
+    result.distance_ratio = std::hypot(sum_x, sum_y) / sum_d2;
+  }
+  if (turning >= kMinMeasuredTurning && std::isfinite(sum_gh + sum_hh)) {
+    result.turn_agreement =
+        sum_hh > 0.0 ? sum_gh / std::sqrt(sum_gg * sum_hh) : 0.0;
+  }
+  return result;
+}
+
+// Rounds to 1e-4 for messages and metadata (+ 0.0: "0", never "-0").
+std::string Short(double value) {
+  return FormatNumber(std::round(value * 1e4) / 1e4 + 0.0);
+}
+
+// Chooses the heading offset of the odometry frame (option, declared,
+// measured) and checks it and the DR columns against the ground truth, so
+// that no frame or convention mismatch reaches the ODOM records silently.
+bool ResolveHeadingOffset(const std::string& prefix,
+                          const PlazaOptions& options, const PlazaRaw& raw,
+                          PlazaSummary* summary, std::string* error) {
+  const std::string dr_path = prefix + "_DR.txt";
+  const OdometryAgreement agreement = MeasureOdometryAgreement(raw);
+  summary->measured_heading_offset = agreement.heading_offset;
+  if (std::isfinite(agreement.distance_ratio) &&
+      !(agreement.distance_ratio >= kMinDistanceRatio &&
+        agreement.distance_ratio <= kMaxDistanceRatio)) {
+    *error = dr_path + ": the DR distances do not match the ground truth " +
+             "(GT moves " + Short(agreement.distance_ratio) +
+             " m per DR metre): column 2 must be the distance travelled " +
+             "since the previous row, in metres";
+    return false;
+  }
+  if (std::isfinite(agreement.turn_agreement) &&
+      !(agreement.turn_agreement >= kMinTurnAgreement)) {
+    *error = dr_path + ": the DR heading column does not follow the " +
+             "ground-truth heading (correlation of the increments " +
+             Short(agreement.turn_agreement) +
+             ", expected about 1): column 3 must be the heading change " +
+             "since the previous row, counter-clockwise, in radians";
+    return false;
+  }
+
+  std::optional<double> declared_gt, declared_dr;
+  if (!ReadDeclaredHeadingOffset(prefix + "_GT.txt", raw.ground_truth_header,
+                                 &declared_gt, error) ||
+      !ReadDeclaredHeadingOffset(dr_path, raw.odometry_header, &declared_dr,
+                                 error)) {
+    return false;
+  }
+  if (declared_gt && declared_dr && *declared_gt != *declared_dr) {
+    *error = prefix + "_{GT,DR}.txt: the headers declare different " +
+             std::string(kHeadingOffsetKey) + " (" +
+             FormatNumber(*declared_gt) + " and " + FormatNumber(*declared_dr) +
+             ")";
+    return false;
+  }
+  const double measured = agreement.heading_offset;
+  const double tolerance = options.heading_offset_tolerance;
+  if (options.heading_offset) {
+    summary->heading_offset = *options.heading_offset;
+    summary->heading_offset_source = "option";
+  } else if (declared_gt || declared_dr) {
+    summary->heading_offset = declared_gt ? *declared_gt : *declared_dr;
+    const std::string name = options.name;
+    summary->heading_offset_source =
+        "declared in " + (declared_gt && declared_dr
+                              ? name + "_GT.txt and " + name + "_DR.txt"
+                              : name + (declared_gt ? "_GT.txt" : "_DR.txt"));
+  } else if (std::isfinite(measured)) {
+    summary->heading_offset = WrapAngle(std::round(measured / M_PI_2) * M_PI_2);
+    summary->heading_offset_source =
+        "measured, not declared (nearest multiple of pi/2)";
+  } else {
+    summary->heading_offset = 0.0;
+    summary->heading_offset_source =
+        "none declared, not measurable from the data";
+  }
+  if (std::isfinite(measured) &&
+      std::abs(WrapAngle(measured - summary->heading_offset)) > tolerance) {
+    *error = dr_path + ": the odometry moves the robot along the " +
+             "ground-truth heading + " + Short(measured) +
+             " rad (measured from the GT displacements), but the heading " +
+             "offset is " + Short(summary->heading_offset) + " rad (" +
+             summary->heading_offset_source +
+             "); set --plaza_heading_offset (or widen " +
+             "--plaza_heading_offset_tolerance, now " +
+             FormatNumber(tolerance) + " rad)";
+    return false;
+  }
+  return true;
 }
 
 // Least squares line truth ~ a * measured + b over the flagged pairs.
@@ -206,6 +435,8 @@ double RoundedRangeSigma(double inlier_sigma) {
 
 std::string ConverterDescription(const PlazaOptions& o) {
   auto n = [](double v) { return FormatNumber(v); };
+  const std::string heading_offset =
+      o.heading_offset ? n(*o.heading_offset) : "auto";
   return "rff_convert --format=plaza --plaza_name=" + o.name +
          " --plaza_calibration=" +
          (o.calibration == PlazaCalibration::kLinear ? "linear" : "none") +
@@ -217,6 +448,8 @@ std::string ConverterDescription(const PlazaOptions& o) {
          " --plaza_odom_sigma_theta_per_rad=" +
          n(o.odometry_sigma_theta_per_radian) +
          " --plaza_landmark_prior_sigma=" + n(o.landmark_prior_sigma) +
+         " --plaza_heading_offset=" + heading_offset +
+         " --plaza_heading_offset_tolerance=" + n(o.heading_offset_tolerance) +
          " --prior_sigma_xy=" + n(o.first_pose_sigma_xy) +
          " --prior_sigma_theta=" + n(o.first_pose_sigma_theta);
 }
@@ -232,6 +465,11 @@ bool CheckOptions(const PlazaOptions& o, std::string* error) {
     *error = "the Plaza dataset name (file prefix) is empty";
     return false;
   }
+  if (o.heading_offset && !std::isfinite(*o.heading_offset)) {
+    *error = "plaza_heading_offset must be finite, got " +
+             FormatNumber(*o.heading_offset);
+    return false;
+  }
   return positive(o.outlier_threshold, "plaza_outlier_threshold") &&
          non_negative(o.range_sigma, "plaza_range_sigma") &&
          positive(o.odometry_sigma_xy_floor, "plaza_odom_sigma_xy_floor") &&
@@ -243,7 +481,8 @@ bool CheckOptions(const PlazaOptions& o, std::string* error) {
                       "plaza_odom_sigma_theta_per_rad") &&
          non_negative(o.landmark_prior_sigma, "plaza_landmark_prior_sigma") &&
          positive(o.first_pose_sigma_xy, "prior_sigma_xy") &&
-         positive(o.first_pose_sigma_theta, "prior_sigma_theta");
+         positive(o.first_pose_sigma_theta, "prior_sigma_theta") &&
+         positive(o.heading_offset_tolerance, "plaza_heading_offset_tolerance");
 }
 
 }  // namespace
@@ -303,6 +542,16 @@ bool FitLinearRangeCalibration(const std::vector<double>& measured,
     const double r = fit->a * measured[i] + fit->b - truth[i];
     sum_squares += r * r;
   }
+  // A non-positive scale maps longer ranges to shorter distances: no sensor
+  // does that, so the pairs do not describe one trajectory (wrong beacon
+  // ids, time base, or a trajectory that is not the one ranged from).
+  if (!(fit->a > 0.0)) {
+    *error = "range calibration: the fitted scale a = " + FormatNumber(fit->a) +
+             " (b = " + FormatNumber(fit->b) +
+             " m) is not positive, which no range sensor produces: the " +
+             "ranges do not match the ground truth";
+    return false;
+  }
   fit->inlier_sigma = std::sqrt(sum_squares / (fit->num_inliers - 2));
   return true;
 }
@@ -329,6 +578,9 @@ bool ConvertPlaza(const std::string& directory, const PlazaOptions& options,
   }
   if (!ReadBeacons(prefix + "_TL.txt", &raw, error)) return false;
   if (!ReadRanges(prefix + "_TD.txt", &raw, error)) return false;
+  if (!ResolveHeadingOffset(prefix, options, raw, summary, error)) {
+    return false;
+  }
 
   const std::vector<TimedPose>& gt = raw.ground_truth;
   summary->ground_truth_rows = gt.size();
@@ -391,11 +643,18 @@ bool ConvertPlaza(const std::string& directory, const PlazaOptions& options,
   }
   summary->ranges_kept = dataset->observations.size();
 
+  // Every pose the solver reads is in the GT heading frame: the prior is GT
+  // row 0 as it is, never moved into the odometry frame.
   const TimedPose& first = gt.front();
   dataset->pose_priors.push_back(
       {{first.t, first.x, first.y, WrapAngle(first.theta)},
        options.first_pose_sigma_xy,
        options.first_pose_sigma_theta});
+  // DR row k moves the odometry frame by Pose2(d, 0, dtheta); that frame is
+  // the GT pose frame turned by the offset R, so in the GT pose frame the
+  // motion is R * Pose2(d, 0, dtheta) * R^-1 = Pose2(R (d, 0), dtheta).
+  double offset_cos, offset_sin;
+  AxisExactCosSin(summary->heading_offset, &offset_cos, &offset_sin);
   for (std::size_t k = 0; k < raw.odometry_distance.size(); ++k) {
     const double d = raw.odometry_distance[k];
     const double dtheta = WrapAngle(raw.odometry_heading[k]);
@@ -405,7 +664,8 @@ bool ConvertPlaza(const std::string& directory, const PlazaOptions& options,
     const double sigma_theta =
         std::max(options.odometry_sigma_theta_floor,
                  options.odometry_sigma_theta_per_radian * std::abs(dtheta));
-    dataset->odometry.push_back({gt[k].t, gt[k + 1].t, d, 0.0, dtheta, sigma_xy,
+    dataset->odometry.push_back({gt[k].t, gt[k + 1].t, Product(d, offset_cos),
+                                 Product(d, offset_sin), dtheta, sigma_xy,
                                  sigma_xy, sigma_theta});
   }
   for (const TimedPose& p : gt) {
@@ -438,6 +698,17 @@ bool ConvertPlaza(const std::string& directory, const PlazaOptions& options,
                     "Tech Research Corporation); see "
                     "third_party_licenses/CMU_PLAZA.txt");
   meta.emplace_back("converter", ConverterDescription(options));
+  const std::string measured_offset =
+      std::isfinite(summary->measured_heading_offset)
+          ? Short(summary->measured_heading_offset) + " rad"
+          : "not measurable";
+  meta.emplace_back(
+      "heading_offset",
+      "odometry frame = GT heading + " + Short(summary->heading_offset) +
+          " rad (" + summary->heading_offset_source +
+          "; measured from the GT displacements: " + measured_offset +
+          "); ODOM = Pose2(d cos(offset), d sin(offset), dtheta) in the GT "
+          "pose frame, PRIOR_POSE and GT_POSE are GT as given");
   if (linear) {
     meta.emplace_back(
         "calibration",

@@ -4,8 +4,17 @@
 // NAME_TL.txt, see data/SOURCES.md) to a .rffd Dataset.
 //
 // The robot trajectory is sampled at the ground-truth times: DR row k is the
-// motion Pose2(d, 0, dtheta) from GT pose k to GT pose k + 1 and becomes one
-// ODOM record. The raw UWB ranges are long by about 7% and carry outliers;
+// motion Pose2(d, 0, dtheta) of the odometry frame from GT time k to k + 1
+// and becomes one ODOM record. Some recordings carry odometry whose heading
+// frame is the GT heading plus a constant offset (gpslam's
+// init_heading_offset; pi in the recording that was reported): the robot then
+// moves d along GT heading + offset, so the ODOM record, expressed in the frame
+// of the GT pose as every pose the solver reads is (PRIOR_POSE, GT_POSE), is
+// Pose2(d cos(offset), d sin(offset), dtheta). The offset is taken from
+// the option, else from the files' "init_heading_offset[rad] = X" header,
+// else measured from the data and rounded to a multiple of pi/2, and always
+// checked against the one measured from the GT displacements.
+// The raw UWB ranges are long by about 7% and carry outliers;
 // the default calibration (after gpslam's range_measure_fit.m) fits
 // r_true ~ a * r + b by least squares against ground truth and drops ranges
 // whose residual exceeds a threshold (FitLinearRangeCalibration). That uses
@@ -16,6 +25,7 @@
 #define RFF_CERES_CONVERT_PLAZA_H_
 
 #include <cstddef>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -52,6 +62,17 @@ struct PlazaOptions {
   // PRIOR_POSE sigmas at GT row 0 (GPS ground truth is good to ~2 cm).
   double first_pose_sigma_xy = 0.02;
   double first_pose_sigma_theta = 0.01;
+  // Heading of the odometry (DR) frame minus the ground-truth heading
+  // [rad]. Unset: the "init_heading_offset" header of NAME_GT.txt or
+  // NAME_DR.txt, or when neither declares one, the offset measured from the
+  // data rounded to a multiple of pi/2 (frames differ by axis conventions;
+  // the rest of the measured offset is a GPS/odometry bias, not a frame).
+  std::optional<double> heading_offset;
+  // The offset measured from the GT displacements must lie this close to the
+  // offset used [rad] (Plaza 1 measures -0.018 rad against 0); a larger gap
+  // means a wrong declaration or a DR file in another convention, which
+  // would hand the solver odometry that drives away from the truth.
+  double heading_offset_tolerance = 0.1;
 };
 
 // Result of the linear range calibration.
@@ -70,7 +91,9 @@ struct LinearRangeFit {
 // the inliers } until the inlier set stops changing. range_measure_fit.m
 // does one such round from the least-squares line of all pairs; on Plaza 1
 // both give the same result. Fails when fewer than 3 pairs (or inliers)
-// remain or the measured values are all equal.
+// remain, the measured values are all equal, or the fitted scale a is not
+// positive (a true distance that shrinks as the measured range grows is not
+// a calibration but ranges that do not belong to the trajectory).
 bool FitLinearRangeCalibration(const std::vector<double>& measured,
                                const std::vector<double>& truth,
                                double outlier_threshold, LinearRangeFit* fit,
@@ -88,6 +111,14 @@ struct PlazaSummary {
   // ranges only with PlazaCalibration::kLinear.
   LinearRangeFit fit;
   double range_sigma = 0.0;  // Sigma written in the RANGE records.
+  // Odometry frame against GT heading: the offset applied to the ODOM
+  // records, where it came from ("option", "declared in ...", "measured"),
+  // and the offset measured from the data (the direction of the GT
+  // displacement in the GT pose frame, weighted by the DR distance; NaN when
+  // the robot moves too little to tell or the sums overflow).
+  double heading_offset = 0.0;
+  std::string heading_offset_source;
+  double measured_heading_offset = 0.0;
 };
 
 // Reads DIRECTORY/NAME_{GT,DR,TD,TL}.txt and fills `dataset` (metadata,

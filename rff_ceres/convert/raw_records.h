@@ -16,10 +16,13 @@ namespace rff {
 
 // Reads every record of `path`; each must have exactly `num_fields` fields.
 // `parse_row(reader, fields, error)` handles one record. A file without data
-// rows is an error.
+// rows is an error. When `leading_comments` is not null it receives the
+// comment-only lines before the first record (the text after '#'), where
+// some raw layouts declare per-recording constants.
 template <typename RowParser>
 bool ReadRecords(const std::string& path, std::size_t num_fields,
-                 RowParser parse_row, std::string* error) {
+                 RowParser parse_row, std::string* error,
+                 std::vector<std::string>* leading_comments = nullptr) {
   std::ifstream stream;
   if (!OpenForReading(path, &stream, error)) return false;
   LineReader reader(&stream, path);
@@ -41,6 +44,9 @@ bool ReadRecords(const std::string& path, std::size_t num_fields,
   if (rows == 0) {
     *error = path + ": no data rows";
     return false;
+  }
+  if (leading_comments != nullptr) {
+    *leading_comments = reader.leading_comments();
   }
   return true;
 }

@@ -1,5 +1,6 @@
 #include "rff_ceres/convert/plaza.h"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -102,6 +103,20 @@ TEST(FitLinearRangeCalibrationTest, InlierSigmaUsesTwoDegreesOfFreedomLess) {
   EXPECT_NEAR(fit.a, 1.0, 1e-12);
   EXPECT_NEAR(fit.b, 0.0, 1e-12);
   EXPECT_NEAR(fit.inlier_sigma, std::sqrt(0.04 / 2.0), 1e-12);
+}
+
+TEST(FitLinearRangeCalibrationTest, RejectsANonPositiveScale) {
+  // Ranges that grow as the true distance shrinks (ground truth run
+  // backwards against them): no sensor does that.
+  const std::vector<double> measured = {10, 20, 30, 40, 50};
+  const std::vector<double> truth = {48, 38.5, 29, 19.5, 10};
+  LinearRangeFit fit;
+  std::string error;
+  EXPECT_FALSE(FitLinearRangeCalibration(measured, truth, 2.0, &fit, &error));
+  EXPECT_EQ(error,
+            "range calibration: the fitted scale a = -0.95 (b = 57.5 m) is "
+            "not positive, which no range sensor produces: the ranges do not "
+            "match the ground truth");
 }
 
 TEST(FitLinearRangeCalibrationTest, RejectsDegenerateInput) {
@@ -289,6 +304,297 @@ TEST(PlazaConvertTest, RejectsBadOptions) {
   EXPECT_EQ(error, "plaza_odom_sigma_xy_floor must be > 0, got 0");
 }
 
+// A raw Plaza recording whose odometry frame is the GT heading frame turned
+// by `offset`: the robot drives a weaving path (with two reversing steps) of
+// DR increments Pose2(d, 0, dtheta) in its odometry frame, and GT_k carries
+// the odometry heading minus `offset`, as gpslam's init_heading_offset
+// defines. `header` is written at the top of GT and DR (empty: none).
+struct RotatedPlaza {
+  std::vector<double> distance, turn;  // DR rows.
+  std::vector<TimedPose> truth;        // GT rows, headings unwrapped.
+};
+
+RotatedPlaza WriteRotatedPlaza(const std::string& dir, double offset,
+                               const std::string& header) {
+  RotatedPlaza raw;
+  double x = 3.0, y = -2.0, heading = 0.7;  // Odometry frame.
+  raw.truth.push_back({0.0, x, y, heading - offset});
+  for (int k = 0; k < 60; ++k) {
+    const double d = (k == 10 || k == 11) ? -0.4 : 0.5;
+    const double turn = 0.3 * std::sin(k / 5.0);
+    x += d * std::cos(heading);
+    y += d * std::sin(heading);
+    heading += turn;
+    raw.distance.push_back(d);
+    raw.turn.push_back(turn);
+    raw.truth.push_back({k + 1.0, x, y, heading - offset});
+  }
+  std::ostringstream gt, dr, td;
+  gt << header;
+  dr << header;
+  for (std::size_t k = 0; k < raw.truth.size(); ++k) {
+    const TimedPose& p = raw.truth[k];
+    gt << FormatNumber(p.t) << " " << FormatNumber(p.x) << " "
+       << FormatNumber(p.y) << " " << FormatNumber(p.theta) << "\n";
+    if (k > 0) {
+      dr << FormatNumber(p.t) << " " << FormatNumber(raw.distance[k - 1]) << " "
+         << FormatNumber(raw.turn[k - 1]) << "\n";
+    }
+    // Beacon 3 at (0, 10), raw ranges as in WriteSmallPlaza.
+    td << FormatNumber(p.t) << " 2 3 "
+       << FormatNumber((std::hypot(p.x, p.y - 10.0) - kB) / kA) << "\n";
+  }
+  WriteFile(dir + "/Rot_GT.txt", gt.str());
+  WriteFile(dir + "/Rot_DR.txt", dr.str());
+  WriteFile(dir + "/Rot_TL.txt", "3 0 10\n");
+  WriteFile(dir + "/Rot_TD.txt", td.str());
+  return raw;
+}
+
+std::string OffsetHeader(double offset) {
+  return "# Rot: time d dtheta\n# init_heading_offset[rad] = " +
+         FormatNumber(offset) +
+         " (add to GT heading to get the heading frame of DR)\n";
+}
+
+// Composes the ODOM records from the PRIOR_POSE and returns the largest
+// position and heading gap to `truth` at the ODOM end times.
+void DeadReckoningGap(const Dataset& d, const std::vector<TimedPose>& truth,
+                      double* position_gap, double* heading_gap) {
+  *position_gap = *heading_gap = 0.0;
+  TimedPose pose = d.pose_priors.at(0).pose;
+  ASSERT_EQ(d.odometry.size() + 1, truth.size());
+  for (std::size_t k = 0; k < d.odometry.size(); ++k) {
+    const Odometry& o = d.odometry[k];
+    ASSERT_EQ(o.t0, pose.t);
+    const double c = std::cos(pose.theta), s = std::sin(pose.theta);
+    pose = {o.t1, pose.x + c * o.dx - s * o.dy, pose.y + s * o.dx + c * o.dy,
+            pose.theta + o.dtheta};
+    const TimedPose& t = truth[k + 1];
+    ASSERT_EQ(pose.t, t.t);
+    *position_gap =
+        std::max(*position_gap, std::hypot(pose.x - t.x, pose.y - t.y));
+    *heading_gap =
+        std::max(*heading_gap, std::abs(WrapAngle(pose.theta - t.theta)));
+  }
+}
+
+bool ConvertRotated(const std::string& dir, const PlazaOptions& base,
+                    Dataset* d, PlazaSummary* s, std::string* error) {
+  PlazaOptions options = base;
+  options.name = "Rot";
+  return ConvertPlaza(dir, options, d, s, error);
+}
+
+TEST(PlazaHeadingOffsetTest, OdometryComposesToTheTruthInAnyFrame) {
+  const double offsets[] = {0.0, M_PI_2, M_PI, -M_PI_2, 0.3, -2.5};
+  for (const double offset : offsets) {
+    for (const bool declared : {true, false}) {
+      // Undeclared offsets are rounded to a multiple of pi/2.
+      if (!declared && (offset == 0.3 || offset == -2.5)) continue;
+      SCOPED_TRACE("offset " + FormatNumber(offset) +
+                   (declared ? " declared" : " measured"));
+      const std::string dir = TempDir();
+      const RotatedPlaza raw =
+          WriteRotatedPlaza(dir, offset, declared ? OffsetHeader(offset) : "");
+      Dataset d;
+      PlazaSummary s;
+      std::string error;
+      ASSERT_TRUE(ConvertRotated(dir, PlazaOptions(), &d, &s, &error)) << error;
+      EXPECT_NEAR(WrapAngle(s.heading_offset - offset), 0.0, 1e-15);
+      EXPECT_NEAR(WrapAngle(s.measured_heading_offset - offset), 0.0, 1e-12);
+      EXPECT_EQ(s.heading_offset_source,
+                declared ? "declared in Rot_GT.txt and Rot_DR.txt"
+                         : "measured, not declared (nearest multiple of "
+                           "pi/2)");
+
+      // The prior is GT row 0, heading included, never the odometry heading.
+      ASSERT_EQ(d.pose_priors.size(), 1u);
+      EXPECT_EQ(d.pose_priors[0].pose.t, raw.truth[0].t);
+      EXPECT_EQ(d.pose_priors[0].pose.x, raw.truth[0].x);
+      EXPECT_EQ(d.pose_priors[0].pose.y, raw.truth[0].y);
+      EXPECT_EQ(d.pose_priors[0].pose.theta, WrapAngle(raw.truth[0].theta));
+      // GT_POSE is the GT as given.
+      ASSERT_EQ(d.ground_truth.size(), raw.truth.size());
+      EXPECT_EQ(d.ground_truth[5].theta, WrapAngle(raw.truth[5].theta));
+
+      double position_gap, heading_gap;
+      DeadReckoningGap(d, raw.truth, &position_gap, &heading_gap);
+      EXPECT_LT(position_gap, 1e-12);
+      EXPECT_LT(heading_gap, 1e-12);
+
+      // The increments are the DR ones turned into the GT pose frame: the
+      // length and the heading change do not depend on the frame.
+      for (std::size_t k = 0; k < d.odometry.size(); ++k) {
+        EXPECT_NEAR(std::hypot(d.odometry[k].dx, d.odometry[k].dy),
+                    std::abs(raw.distance[k]), 1e-15);
+        EXPECT_EQ(d.odometry[k].dtheta, raw.turn[k]);
+      }
+    }
+  }
+}
+
+TEST(PlazaHeadingOffsetTest, AxisAlignedOffsetsGiveExactIncrements) {
+  const std::string dir = TempDir();
+  const RotatedPlaza raw = WriteRotatedPlaza(dir, M_PI, OffsetHeader(M_PI));
+  Dataset d;
+  PlazaSummary s;
+  std::string error;
+  ASSERT_TRUE(ConvertRotated(dir, PlazaOptions(), &d, &s, &error)) << error;
+  EXPECT_EQ(d.odometry[0].dx, -0.5);
+  EXPECT_EQ(d.odometry[0].dy, 0.0);
+  EXPECT_FALSE(std::signbit(d.odometry[0].dy));  // Written "0", not "-0".
+  EXPECT_EQ(d.odometry[10].dx, 0.4);             // A reversing step.
+  std::ostringstream out;
+  WriteDataset(d, &out);
+  EXPECT_THAT(out.str(),
+              HasSubstr("# heading_offset: odometry frame = GT heading + "
+                        "3.1416 rad (declared in Rot_GT.txt and Rot_DR.txt; "
+                        "measured from the GT displacements: 3.1416 rad)"));
+  EXPECT_THAT(out.str(), HasSubstr("--plaza_heading_offset=auto"));
+}
+
+TEST(PlazaHeadingOffsetTest, TheOldReadingDrivesAwayFromTheTruth) {
+  // What the converter did before it knew the offset: Pose2(d, 0, dtheta) in
+  // the GT frame. With the frame pi off, dead reckoning runs backwards.
+  const std::string dir = TempDir();
+  const RotatedPlaza raw = WriteRotatedPlaza(dir, M_PI, OffsetHeader(M_PI));
+  PlazaOptions forced;
+  forced.heading_offset = 0.0;
+  forced.heading_offset_tolerance = 4.0;  // Let the wrong frame through.
+  Dataset d;
+  PlazaSummary s;
+  std::string error;
+  ASSERT_TRUE(ConvertRotated(dir, forced, &d, &s, &error)) << error;
+  double position_gap, heading_gap;
+  DeadReckoningGap(d, raw.truth, &position_gap, &heading_gap);
+  EXPECT_GT(position_gap, 10.0);
+}
+
+TEST(PlazaHeadingOffsetTest, OptionOverridesTheHeader) {
+  const std::string dir = TempDir();
+  // The header says 0 but the data are pi off: the option fixes it.
+  const RotatedPlaza raw = WriteRotatedPlaza(dir, M_PI, OffsetHeader(0.0));
+  PlazaOptions options;
+  options.heading_offset = -M_PI;
+  Dataset d;
+  PlazaSummary s;
+  std::string error;
+  ASSERT_TRUE(ConvertRotated(dir, options, &d, &s, &error)) << error;
+  EXPECT_EQ(s.heading_offset_source, "option");
+  double position_gap, heading_gap;
+  DeadReckoningGap(d, raw.truth, &position_gap, &heading_gap);
+  EXPECT_LT(position_gap, 1e-12);
+  std::ostringstream out;
+  WriteDataset(d, &out);
+  EXPECT_THAT(out.str(), HasSubstr("--plaza_heading_offset=-3.14159265358979"));
+}
+
+// Converts the rotated recording after replacing one file, expecting an
+// error.
+std::string RotatedError(const std::string& dir, double offset,
+                         const std::string& header, const std::string& file,
+                         const std::string& text,
+                         const PlazaOptions& options = PlazaOptions()) {
+  WriteRotatedPlaza(dir, offset, header);
+  if (!file.empty()) WriteFile(dir + "/" + file, text);
+  Dataset d;
+  PlazaSummary s;
+  std::string error;
+  EXPECT_FALSE(ConvertRotated(dir, options, &d, &s, &error));
+  return error;
+}
+
+TEST(PlazaHeadingOffsetTest, RejectsAnOffsetTheDataContradict) {
+  const std::string dir = TempDir();
+  // Declared 0, data pi off: the reported bug, now an error.
+  EXPECT_EQ(RotatedError(dir, M_PI, OffsetHeader(0.0), "", ""),
+            dir +
+                "/Rot_DR.txt: the odometry moves the robot along the "
+                "ground-truth heading + 3.1416 rad (measured from the GT "
+                "displacements), but the heading offset is 0 rad (declared "
+                "in Rot_GT.txt and Rot_DR.txt); set --plaza_heading_offset "
+                "(or widen --plaza_heading_offset_tolerance, now 0.1 rad)");
+  // Undeclared and not a multiple of pi/2.
+  EXPECT_THAT(RotatedError(dir, 0.3, "", "", ""),
+              HasSubstr("ground-truth heading + 0.3 rad (measured from the "
+                        "GT displacements), but the heading offset is 0 rad "
+                        "(measured, not declared (nearest multiple of "
+                        "pi/2))"));
+  // A wrong option is checked too.
+  PlazaOptions wrong;
+  wrong.heading_offset = 0.0;
+  EXPECT_THAT(RotatedError(dir, M_PI_2, "", "", "", wrong),
+              HasSubstr("but the heading offset is 0 rad (option)"));
+}
+
+TEST(PlazaHeadingOffsetTest, RejectsBadDeclarations) {
+  const std::string dir = TempDir();
+  EXPECT_EQ(
+      RotatedError(dir, 0.0, "# init_heading_offset[deg] = 180\n", "", ""),
+      dir +
+          "/Rot_GT.txt: header '# init_heading_offset[deg] = 180': the "
+          "heading offset must be given in [rad]");
+  EXPECT_EQ(RotatedError(dir, 0.0, "# init_heading_offset = pi\n", "", ""),
+            dir +
+                "/Rot_GT.txt: header '# init_heading_offset = pi': 'pi' is "
+                "not a finite number");
+  EXPECT_EQ(RotatedError(dir, 0.0, "# init_heading_offset 0\n", "", ""),
+            dir +
+                "/Rot_GT.txt: header '# init_heading_offset 0': expected '=' "
+                "after init_heading_offset");
+  // GT and DR must agree.
+  WriteRotatedPlaza(dir, M_PI, OffsetHeader(M_PI));
+  std::string dr = ReadFile(dir + "/Rot_DR.txt");
+  dr.replace(dr.find("3.141592653589793"), 17, "3.1416");
+  WriteFile(dir + "/Rot_DR.txt", dr);
+  Dataset d;
+  PlazaSummary s;
+  std::string error;
+  EXPECT_FALSE(ConvertRotated(dir, PlazaOptions(), &d, &s, &error));
+  EXPECT_EQ(error, dir +
+                       "/Rot_{GT,DR}.txt: the headers declare different "
+                       "init_heading_offset (3.141592653589793 and 3.1416)");
+}
+
+TEST(PlazaHeadingOffsetTest, RejectsDrColumnsInAnotherConvention) {
+  const std::string dir = TempDir();
+  const RotatedPlaza raw = WriteRotatedPlaza(dir, 0.0, "");
+  auto dr_with = [&](auto column) {
+    std::ostringstream dr;
+    for (std::size_t k = 0; k < raw.distance.size(); ++k) {
+      double d = raw.distance[k], dtheta = raw.turn[k];
+      column(k, &d, &dtheta);
+      dr << FormatNumber(raw.truth[k + 1].t) << " " << FormatNumber(d) << " "
+         << FormatNumber(dtheta) << "\n";
+    }
+    return dr.str();
+  };
+  const std::string heading_problem =
+      "/Rot_DR.txt: the DR heading column does not follow the ground-truth "
+      "heading";
+  // Clockwise heading changes.
+  EXPECT_THAT(RotatedError(dir, 0.0, "", "Rot_DR.txt",
+                           dr_with([](std::size_t, double*, double* dtheta) {
+                             *dtheta = -*dtheta;
+                           })),
+              HasSubstr(heading_problem + " (correlation of the increments "
+                                          "-1, expected about 1)"));
+  // Absolute odometry headings instead of increments.
+  EXPECT_THAT(RotatedError(dir, 0.0, "", "Rot_DR.txt",
+                           dr_with([&](std::size_t k, double*, double* dtheta) {
+                             *dtheta = raw.truth[k + 1].theta;
+                           })),
+              HasSubstr(heading_problem));
+  // Distances in feet.
+  EXPECT_THAT(RotatedError(dir, 0.0, "", "Rot_DR.txt",
+                           dr_with([](std::size_t, double* d, double*) {
+                             *d /= 0.3048;
+                           })),
+              HasSubstr("/Rot_DR.txt: the DR distances do not match the "
+                        "ground truth (GT moves 0.3048 m per DR metre)"));
+}
+
 TEST(PlazaBundledTest, CountsFirstRecordsAndDeadReckoning) {
   const std::string path = std::string(RFF_SOURCE_DIR) + "/data/plaza1.rffd";
   Dataset d;
@@ -334,6 +640,17 @@ TEST(PlazaBundledTest, CountsFirstRecordsAndDeadReckoning) {
   EXPECT_NEAR(d.observations[0].range, a * 65.46600784 + b, 1e-9);
   EXPECT_EQ(d.observations[0].sigma_range, 0.5);
 
+  // Plaza 1 declares no heading offset, and its data agree.
+  bool has_heading_offset = false;
+  for (const auto& [key, value] : d.metadata) {
+    if (key != "heading_offset") continue;
+    has_heading_offset = true;
+    EXPECT_THAT(value, HasSubstr("GT heading + 0 rad (declared in "
+                                 "Plaza1_GT.txt and Plaza1_DR.txt; measured "
+                                 "from the GT displacements: -0.018 rad)"));
+  }
+  EXPECT_TRUE(has_heading_offset);
+
   // Dead reckoning from the prior ends up ~2 m RMS from the truth.
   const double rms = DeadReckoningRms(d);
   EXPECT_NEAR(rms, 1.97, 0.01);
@@ -355,6 +672,8 @@ TEST(PlazaSharedTest, RawDataConvertsToTheBundledFile) {
   EXPECT_NEAR(s.fit.b, 0.018, 0.001);
   EXPECT_NEAR(s.fit.inlier_sigma, 0.505, 0.001);
   EXPECT_EQ(s.range_sigma, 0.5);
+  EXPECT_EQ(s.heading_offset, 0.0);
+  EXPECT_NEAR(s.measured_heading_offset, -0.018, 0.001);
   std::ostringstream out;
   WriteDataset(d, &out);
   EXPECT_TRUE(out.str() ==
