@@ -51,7 +51,9 @@ DEFINE_string(learn_hyperparameters, "auto",
               "by the Laplace approximation of the marginal likelihood on the "
               "first 300 s, starting from --lengthscale, --kernel_variance, "
               "...: on, off, or auto (on for data without odometry; batch "
-              "mode only).");
+              "mode only; off when any of those four is given, on the "
+              "command line or in a flagfile, as they are then the user's "
+              "choice).");
 DEFINE_uint64(seed, 1, "Seed of the random feature frequencies.");
 DEFINE_double(segment_length, 0.0,
               "Windowed weights: segment length in seconds (0: one global "
@@ -138,6 +140,19 @@ DEFINE_double(gradient_tolerance, 1e-10, "Ceres gradient tolerance.");
 DEFINE_double(parameter_tolerance, 1e-8, "Ceres parameter tolerance.");
 
 namespace rff {
+namespace {
+
+// True when the user set a kernel hyperparameter (command line or flagfile):
+// "auto" learning then keeps the user's values.
+bool KernelHyperparametersGiven() {
+  for (const char* flag : {"lengthscale", "kernel_variance",
+                           "heading_lengthscale", "heading_kernel_variance"}) {
+    if (!gflags::GetCommandLineFlagInfoOrDie(flag).is_default) return true;
+  }
+  return false;
+}
+
+}  // namespace
 
 SlamOptions SlamOptionsFromFlags() {
   SlamOptions options;
@@ -161,6 +176,9 @@ SlamOptions SlamOptionsFromFlags() {
   options.incremental.lag = FLAGS_incremental_lag;
   options.outer_rounds = FLAGS_outer_rounds;
   options.learn_hyperparameters = FLAGS_learn_hyperparameters;
+  if (options.learn_hyperparameters == "auto" && KernelHyperparametersGiven()) {
+    options.learn_hyperparameters = "off";
+  }
   options.spline_smoothing = FLAGS_spline_smoothing;
   FeatureTrajectoryOptions& t = options.trajectory;
   t.position_kernel.name = FLAGS_kernel;

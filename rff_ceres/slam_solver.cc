@@ -448,11 +448,6 @@ bool InitializeBlocks(const Dataset& start, const SlamOptions& options,
                       std::string* error) {
   result->initial_trajectory = "mean";
   if (options.initial_trajectory == "mean") return true;
-  if (options.initial_trajectory != "auto") {
-    *error = "unknown initial trajectory '" + options.initial_trajectory +
-             "' (expected auto or mean)";
-    return false;
-  }
   std::vector<TimedPose> pilot;
   std::string why;
   if (!BuildPilotTrajectory(start, options.localization, OutputTimes(start),
@@ -478,6 +473,12 @@ bool RunSlam(const Dataset& dataset, const SlamOptions& options,
       options.learn_hyperparameters != "off") {
     *error = "learn_hyperparameters must be auto, on or off, got '" +
              options.learn_hyperparameters + "'";
+    return false;
+  }
+  if (options.initial_trajectory != "auto" &&
+      options.initial_trajectory != "mean") {
+    *error = "initial_trajectory must be auto or mean, got '" +
+             options.initial_trajectory + "'";
     return false;
   }
   if (options.outer_rounds < 0) {

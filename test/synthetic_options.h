@@ -11,7 +11,9 @@ namespace testing {
 
 inline SlamOptions SyntheticRangeBearingOptions() {
   SlamOptions options;
-  options.prior_mean = "auto";
+  options.prior_mean = "localization";
+  // The flags give the kernel hyperparameters, so "auto" learning is off.
+  options.learn_hyperparameters = "off";
   FeatureTrajectoryOptions& t = options.trajectory;
   t.position_kernel.name = "rbf";
   t.position_kernel.lengthscale = 5.0;

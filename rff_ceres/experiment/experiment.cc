@@ -208,6 +208,11 @@ void SolveAndEvaluate(const Dataset& dataset, const SlamOptions& base,
     FailRow("solve: " + error, row);
     return;
   }
+  // What "auto" settled on, not what was asked for.
+  row->linear_solver = result.linear_solver;
+  if (options.prior == "rff") {
+    row->num_features = result.trajectory_options.num_position_features;
+  }
   row->iterations = result.total_iterations;
   row->final_cost = result.summary.final_cost;
   row->solve_seconds = result.solve_seconds;

@@ -82,9 +82,10 @@ std::shared_ptr<const MeanFunction> BuildPriorMean(
     LocalizationReport report;
     return BuildLocalizationMean(dataset, localization, &report, error);
   }
-  // "spline": through the auto mean at every observation and prior time.
+  // "spline": the paper's smoothing spline (III-B.2) through the
+  // localisation at every observation and prior time.
   std::shared_ptr<const MeanFunction> base =
-      BuildPriorMean("auto", dataset, localization, error);
+      BuildPriorMean("localization", dataset, localization, error);
   if (!base) return nullptr;
   std::vector<double> times;
   for (const Observation& o : dataset.observations) times.push_back(o.t);

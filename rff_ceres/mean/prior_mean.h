@@ -21,13 +21,13 @@ std::vector<std::string> PriorMeanNames();
 // "localization": per-time localisation against the PRIOR_LANDMARK means,
 //   smoothed robustly; fused with dead reckoning when the dataset has ODOM
 //   (see localization_mean.h and docs/prior_means.md).
-// "spline": a smoothing spline (p = 0.98) through the "auto" mean at the
-//   observation times, the first round of the paper's III-B.2.
+// "spline": a smoothing spline (p = 0.98) through the "localization" mean at
+//   the observation times, the first round of the paper's III-B.2.
 // "constant": the earliest PRIOR_POSE at every time.
 // "auto": odometry if the dataset has ODOM records, else constant: the mean
 //   comes from the inputs only (the observations enter as residuals; a
 //   localisation of them is the solver's initial value, not its mean).
-// "localization" (also through "auto" and "spline") uses `localization`.
+// "localization" (also through "spline") uses `localization`.
 std::shared_ptr<const MeanFunction> BuildPriorMean(
     const std::string& name, const Dataset& dataset,
     const LocalizationOptions& localization, std::string* error);
