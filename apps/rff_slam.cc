@@ -18,6 +18,7 @@
 #include "rff_ceres/io/pose_covariance_io.h"
 #include "rff_ceres/io/tum_io.h"
 #include "rff_ceres/metrics.h"
+#include "rff_ceres/slam_report.h"
 #include "rff_ceres/slam_solver.h"
 #include "slam_flags.h"
 
@@ -29,6 +30,9 @@ DEFINE_string(output_covariance, "",
               "syy syt stt per line); the landmarks file then carries "
               "sxx sxy syy.");
 DEFINE_string(summary_json, "", "Write the solve summary here (JSON).");
+DEFINE_bool(fail_on_suspect, false,
+            "Exit with status 3 when the quality verdict is 'suspect' (the "
+            "outputs are still written, for inspection).");
 DEFINE_bool(evaluate, true,
             "Print APE/RPE/landmark errors when the dataset has ground truth.");
 
@@ -93,5 +97,7 @@ int main(int argc, char** argv) {
     }
     rff::PrintEvaluation(evaluation, &std::cout);
   }
-  return 0;
+  std::cerr << "rff_slam: quality " << rff::QualityLine(result.quality)
+            << "\n";
+  return FLAGS_fail_on_suspect && result.quality.suspect() ? 3 : 0;
 }

@@ -38,6 +38,11 @@ bool CreateLoss(const LossOptions& options,
 // RANGE_BEARING record is modelled as scale * distance + offset with one
 // (scale, offset) for the whole run, under the prior scale ~ N(1,
 // scale_sigma^2), offset ~ N(0, offset_sigma^2).
+// Bounds of the range self-calibration (scale, offset): a physical sensor.
+inline constexpr double kMinRangeScale = 0.5;
+inline constexpr double kMaxRangeScale = 2.0;
+inline constexpr double kMaxOffsetSigmas = 5.0;
+
 struct RangeCalibrationOptions {
   bool estimate = false;
   double scale_sigma = 0.1;
@@ -116,6 +121,11 @@ class SlamProblem {
   // ill-conditioned (condition number above `max_condition`): its estimate
   // would be noise.
   bool FindNonFinite(std::string* description);
+  // The whitened residuals (without the robust loss) at the current values,
+  // grouped by what they are: "range", "bearing", "range-bearing",
+  // "odometry", "landmark prior", "pose prior", "range calibration prior"
+  // and "trajectory prior" (the model's own: RFF weights, WNOA motion).
+  std::map<std::string, std::vector<double>> WhitenedResidualsByKind();
   bool CheckLandmarksDetermined(double max_condition, std::string* error);
   // Information of a landmark given the trajectory, sum of J_l^T J_l over its
   // residuals (through the robust loss if `apply_loss`); zero if unknown.

@@ -16,6 +16,7 @@
 #include "rff_ceres/hyperparameter_learning.h"
 #include "rff_ceres/initialization.h"
 #include "rff_ceres/mean/localization_mean.h"
+#include "rff_ceres/quality_report.h"
 #include "rff_ceres/slam_problem.h"
 #include "rff_ceres/types.h"
 #include "rff_ceres/wnoa_trajectory.h"
@@ -116,6 +117,8 @@ struct SlamResult {
   std::string initial_trajectory;  // "localization" (the pilot) or "mean".
   // (scale, offset) of the range sensor; (1, 0) unless estimated.
   Eigen::Vector2d range_calibration = Eigen::Vector2d(1.0, 0.0);
+  // The whitened residuals at the solution and the verdict on them.
+  QualityReport quality;
 };
 
 // Runs the solve. Returns false with a message on bad options or input, and
@@ -132,15 +135,6 @@ std::unique_ptr<TrajectoryModel> CreateTrajectoryModel(
 // Times at which RunSlam reports the trajectory: every distinct observation
 // and GT_POSE time, or, when there are none, the odometry and prior times.
 std::vector<double> OutputTimes(const Dataset& dataset);
-
-// Prints the model, problem size, iterations, costs and times (and the
-// incremental updates' times) for people.
-void PrintSlamSummary(const SlamOptions& options, const SlamResult& result,
-                      std::ostream* out);
-
-// Writes the summary (options, costs, iterations, times) as JSON.
-bool WriteSummaryJson(const SlamOptions& options, const SlamResult& result,
-                      const std::string& path, std::string* error);
 
 }  // namespace rff
 

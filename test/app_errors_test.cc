@@ -335,6 +335,42 @@ INSTANTIATE_TEST_SUITE_P(Cases, AppErrorTest, ::testing::ValuesIn(kAppCases),
 // ---------------------------------------------------------------------------
 // Hostile files through the apps, where the case needs more than one file.
 
+// The quality verdict is on stderr and in the JSON; --fail_on_suspect turns a
+// "suspect" one into exit status 3, with the outputs written for inspection.
+TEST(AppQualityTest, SuspectVerdictExitsThreeOnlyWhenAsked) {
+  const std::string dir = testing::TempDir("app_quality_test");
+  WriteFile(dir + "/valid.rffd", ValidDataset(0.0));
+  // The odometry drives backwards while every range-bearing says forwards.
+  std::string backwards = ValidDataset(0.0);
+  for (std::size_t at = backwards.find(" 1 0 0 0.05"); at != std::string::npos;
+       at = backwards.find(" 1 0 0 0.05", at + 1)) {
+    backwards.replace(at, 11, " -1 0 0 0.05");
+  }
+  WriteFile(dir + "/backwards.rffd", backwards);
+  const std::string slam =
+      "{bin}/rff_slam --fail_on_suspect --output_trajectory={dir}/out.tum "
+      "--summary_json={dir}/out.json --dataset={dir}/";
+  RunResult run = RunCommand(Expand(slam + "valid.rffd", dir));
+  EXPECT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_THAT(run.output, HasSubstr("rff_slam: quality ok\n"));
+  EXPECT_THAT(ReadFile(dir + "/out.json"), HasSubstr("\"quality\": \"ok\""));
+
+  run = RunCommand(Expand(slam + "backwards.rffd", dir));
+  EXPECT_EQ(run.exit_code, 3) << run.output;
+  EXPECT_THAT(run.output,
+              HasSubstr("rff_slam: quality suspect: odometry chi2/n "));
+  EXPECT_THAT(ReadFile(dir + "/out.json"),
+              HasSubstr("\"quality\": \"suspect\""));
+  EXPECT_TRUE(std::filesystem::exists(dir + "/out.tum"));
+
+  run = RunCommand(Expand(
+      "{bin}/rff_slam --output_trajectory={dir}/out.tum "
+      "--dataset={dir}/backwards.rffd",
+      dir));
+  EXPECT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_THAT(run.output, HasSubstr("rff_slam: quality suspect: "));
+}
+
 TEST(AppHostileFileTest, ConvertRawFileErrorNamesFileAndLineAndWritesNothing) {
   const std::string dir = testing::TempDir("app_errors_test");
   WriteFile(dir + "/Tiny_GT.txt", "0 0 0 0\r\n1 1 0 nan\r\n");

@@ -1,0 +1,88 @@
+#include "rff_ceres/quality_report.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <iomanip>
+#include <sstream>
+
+
+namespace rff {
+namespace {
+
+// P(|r| > 3) for r ~ N(0, 1).
+constexpr double kNormalBeyond3Sigma = 0.0026997960632601866;
+
+// P(X >= k) for X ~ Poisson(lambda), the count of rare events among many.
+double PoissonUpperTail(double lambda, int k) {
+  double term = std::exp(-lambda);  // P(X = 0)
+  double below = 0.0;
+  for (int i = 0; i < k; ++i) {
+    below += term;
+    term *= lambda / (i + 1);
+  }
+  return std::max(0.0, 1.0 - below);
+}
+
+// Three significant digits, for messages.
+std::string Short(double value) {
+  std::ostringstream text;
+  text << std::setprecision(3) << value;
+  return text.str();
+}
+
+}  // namespace
+
+QualityReport AssessQuality(
+    const std::map<std::string, std::vector<double>>& residuals,
+    const SolveFacts& facts) {
+  QualityReport report;
+  if (!facts.converged) {
+    report.reasons.push_back("the solver stopped before convergence (" +
+                             facts.termination + ")");
+  }
+  for (const auto& [kind, values] : residuals) {
+    if (values.empty()) continue;
+    ResidualKindQuality q;
+    q.kind = kind;
+    q.residuals = static_cast<int>(values.size());
+    int beyond = 0;
+    for (const double r : values) {
+      q.chi2_per_residual += r * r;
+      if (std::abs(r) > 3.0) ++beyond;
+    }
+    q.chi2_per_residual /= q.residuals;
+    q.share_beyond_3_sigma = static_cast<double>(beyond) / q.residuals;
+    if (q.chi2_per_residual > kMaxChi2PerResidual) {
+      report.reasons.push_back(kind + " chi2/n " +
+                               Short(q.chi2_per_residual) + " > " +
+                               Short(kMaxChi2PerResidual));
+    }
+    if (q.share_beyond_3_sigma > kMaxShareBeyond3Sigma &&
+        PoissonUpperTail(kNormalBeyond3Sigma * q.residuals, beyond) <
+            kOutlierCountProbability) {
+      report.reasons.push_back(
+          kind + " " + Short(100.0 * q.share_beyond_3_sigma) +
+          "% beyond 3 sigma > " + Short(100.0 * kMaxShareBeyond3Sigma) + "%");
+    }
+    report.kinds.push_back(q);
+  }
+  if (facts.range_calibrated && facts.range_calibration_at_bound) {
+    report.reasons.push_back(
+        "the range calibration (scale " + Short(facts.range_calibration[0]) +
+        ", offset " + Short(facts.range_calibration[1]) +
+        " m) is held by its bound");
+  }
+  if (!report.reasons.empty()) report.verdict = "suspect";
+  return report;
+}
+
+std::string QualityLine(const QualityReport& report) {
+  std::string line = report.verdict;
+  for (std::size_t i = 0; i < report.reasons.size(); ++i) {
+    line += (i == 0 ? ": " : "; ") + report.reasons[i];
+  }
+  return line;
+}
+
+}  // namespace rff

@@ -1,0 +1,62 @@
+// Is the solution believable? The whitened residuals r = L^T (z - h(x)) of a
+// correct model at its MAP are close to N(0, 1): per observation kind the
+// normalised chi-square sum(r^2) / n is near 1 and about 0.27% of them lie
+// beyond 3 sigma. A wrong basin (a mirrored or rotated map, a landmark on
+// the wrong side) shows as a kind far above both. The report gives both per
+// kind and a verdict: "ok", or "suspect" with the reasons.
+#ifndef RFF_CERES_QUALITY_REPORT_H_
+#define RFF_CERES_QUALITY_REPORT_H_
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include "Eigen/Core"
+
+namespace rff {
+
+// Above these a kind's fit is not what its sigmas promise. Real sensors'
+// sigmas are rarely exact, so the bounds leave a factor of a few.
+inline constexpr double kMaxChi2PerResidual = 4.0;
+inline constexpr double kMaxShareBeyond3Sigma = 0.05;
+// A few outliers among a few residuals are chance: the share counts only
+// when that many beyond 3 sigma would be rarer than this under N(0, 1).
+inline constexpr double kOutlierCountProbability = 1e-3;
+
+struct ResidualKindQuality {
+  std::string kind;  // "range", "odometry", "landmark prior", ...
+  int residuals = 0;
+  double chi2_per_residual = 0.0;     // sum(r^2) / n
+  double share_beyond_3_sigma = 0.0;  // |r| > 3, as a fraction
+};
+
+struct QualityReport {
+  std::vector<ResidualKindQuality> kinds;  // Sorted by kind.
+  std::string verdict = "ok";              // "ok" or "suspect"
+  std::vector<std::string> reasons;        // Why "suspect", one line each.
+  bool suspect() const { return verdict != "ok"; }
+};
+
+// What AssessQuality needs beyond the residuals.
+struct SolveFacts {
+  bool converged = true;  // Ceres reported CONVERGENCE.
+  std::string termination;
+  // Range self-calibration, when estimated: (scale, offset) and whether a
+  // bound of slam_problem.h holds it.
+  bool range_calibrated = false;
+  Eigen::Vector2d range_calibration = Eigen::Vector2d(1.0, 0.0);
+  bool range_calibration_at_bound = false;
+};
+
+// `residuals`: whitened residuals by kind (SlamProblem::
+// WhitenedResidualsByKind at the solution).
+QualityReport AssessQuality(
+    const std::map<std::string, std::vector<double>>& residuals,
+    const SolveFacts& facts);
+
+// One line for people: "ok" or "suspect: <reasons joined by '; '>".
+std::string QualityLine(const QualityReport& report);
+
+}  // namespace rff
+
+#endif  // RFF_CERES_QUALITY_REPORT_H_

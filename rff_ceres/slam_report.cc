@@ -1,0 +1,186 @@
+#include "rff_ceres/slam_report.h"
+
+#include <algorithm>
+#include <fstream>
+
+#include "ceres/types.h"
+#include "rff_ceres/io/text_parser.h"
+
+namespace rff {
+namespace {
+
+// Mean and max of the incremental update times.
+void UpdateTimes(const SlamResult& result, double* mean, double* max) {
+  *mean = 0.0;
+  *max = 0.0;
+  for (const IncrementalUpdate& u : result.updates) {
+    *mean += u.seconds;
+    *max = std::max(*max, u.seconds);
+  }
+  if (!result.updates.empty()) *mean /= result.updates.size();
+}
+
+}  // namespace
+
+void PrintSlamSummary(const SlamOptions& options, const SlamResult& result,
+                      std::ostream* out) {
+  const ceres::Solver::Summary& s = result.summary;
+  const FeatureTrajectoryOptions& t = result.trajectory_options;
+  if (options.prior == "wnoa") {
+    *out << "  model        WNOA (LTV-SDE) prior, Q_c = "
+         << options.wnoa.position_qc << " (x, y), " << options.wnoa.heading_qc
+         << " (theta), " << options.prior_mean << " mean\n";
+  } else {
+    *out << "  model        " << t.family << " features, "
+         << t.position_kernel.name << " kernel, D = " << t.num_position_features
+         << " (x, y), " << t.num_heading_features << " (theta), "
+         << options.prior_mean << " mean\n";
+    *out << "  kernels      lengthscale " << t.position_kernel.lengthscale
+         << " s, variance " << t.position_kernel.variance
+         << " (x, y); lengthscale " << t.heading_kernel.lengthscale
+         << " s, variance " << t.heading_kernel.variance << " (theta)";
+    if (t.segment_length > 0.0) {
+      *out << "; segments of " << t.segment_length << " s blended over "
+           << t.segment_overlap << " s";
+    }
+    *out << "\n";
+    if (result.learned) {
+      *out << "  learned      by the Laplace evidence on the first "
+           << result.learning.window_end - result.trajectory.front().t
+           << " s: log evidence " << result.learning.log_evidence << ", "
+           << result.learning.evaluations << " solves, "
+           << result.learning.seconds << " s\n";
+    }
+  }
+  *out << "  problem      " << s.num_residual_blocks << " residual blocks, "
+       << s.num_parameters << " parameters\n"
+       << "  solver       " << options.solver.linear_solver << " -> "
+       << result.linear_solver << " (" << result.linear_solver_reason << "), "
+       << result.total_iterations << " iterations, "
+       << ceres::TerminationTypeToString(s.termination_type) << "\n"
+       << "  cost         " << s.initial_cost << " -> " << s.final_cost << "\n"
+       << "  time         " << s.total_time_in_seconds << " s in Ceres, "
+       << result.solve_seconds << " s total\n";
+  *out << "  start        initial trajectory from the "
+       << result.initial_trajectory;
+  if (result.start_heading.resolved) {
+    *out << "; start heading unknown, resolved to "
+         << result.start_heading.heading << " rad (prior "
+         << result.start_heading.prior_heading << ")";
+  }
+  *out << "\n";
+  if (options.problem.range_calibration.estimate) {
+    *out << "  range model  " << result.range_calibration[0] << " * distance + "
+         << result.range_calibration[1] << " m\n";
+  }
+  if (!result.updates.empty()) {
+    double mean, max;
+    UpdateTimes(result, &mean, &max);
+    *out << "  incremental  " << result.updates.size() << " updates (every "
+         << options.incremental.every << " measurements), " << mean * 1e3
+         << " ms mean, " << max * 1e3 << " ms max per update\n";
+  }
+  *out << "  residuals   ";
+  for (const ResidualKindQuality& q : result.quality.kinds) {
+    *out << " " << q.kind << " chi2/n " << q.chi2_per_residual << " ("
+         << 100.0 * q.share_beyond_3_sigma << "% > 3 sigma);";
+  }
+  *out << "\n  quality      " << QualityLine(result.quality) << "\n";
+  if (!result.converged) {
+    *out << "  warning: the solver stopped before convergence: " << s.message
+         << "\n";
+  }
+}
+
+bool WriteSummaryJson(const SlamOptions& options, const SlamResult& result,
+                      const std::string& path, std::string* error) {
+  std::ofstream out;
+  if (!OpenForWriting(path, &out, error)) return false;
+  const ceres::Solver::Summary& s = result.summary;
+  const FeatureTrajectoryOptions& t = result.trajectory_options;
+  double update_mean, update_max;
+  UpdateTimes(result, &update_mean, &update_max);
+  out << "{\n"
+      << "  \"prior\": " << JsonString(options.prior) << ",\n"
+      << "  \"prior_mean\": " << JsonString(options.prior_mean) << ",\n"
+      << "  \"kernel\": " << JsonString(t.position_kernel.name) << ",\n"
+      << "  \"heading_kernel\": " << JsonString(t.heading_kernel.name) << ",\n"
+      << "  \"lengthscale\": " << FormatNumber(t.position_kernel.lengthscale)
+      << ",\n"
+      << "  \"kernel_variance\": " << FormatNumber(t.position_kernel.variance)
+      << ",\n"
+      << "  \"heading_lengthscale\": "
+      << FormatNumber(t.heading_kernel.lengthscale) << ",\n"
+      << "  \"heading_kernel_variance\": "
+      << FormatNumber(t.heading_kernel.variance) << ",\n"
+      << "  \"segment_length\": " << FormatNumber(t.segment_length) << ",\n"
+      << "  \"segment_overlap\": " << FormatNumber(t.segment_overlap) << ",\n"
+      << "  \"learn_hyperparameters\": " << (result.learned ? "true" : "false")
+      << ",\n"
+      << "  \"log_evidence\": " << FormatNumber(result.learning.log_evidence)
+      << ",\n"
+      << "  \"learning_solves\": " << result.learning.evaluations << ",\n"
+      << "  \"learning_seconds\": " << FormatNumber(result.learning.seconds)
+      << ",\n"
+      << "  \"features\": " << JsonString(t.family) << ",\n"
+      << "  \"num_features\": " << t.num_position_features << ",\n"
+      << "  \"num_heading_features\": " << t.num_heading_features << ",\n"
+      << "  \"seed\": " << t.seed << ",\n"
+      << "  \"wnoa_position_qc\": " << FormatNumber(options.wnoa.position_qc)
+      << ",\n"
+      << "  \"wnoa_heading_qc\": " << FormatNumber(options.wnoa.heading_qc)
+      << ",\n"
+      << "  \"loss\": " << JsonString(options.problem.loss.name) << ",\n"
+      << "  \"odometry_loss\": "
+      << JsonString(options.problem.odometry_loss.name) << ",\n"
+      << "  \"linear_solver\": " << JsonString(result.linear_solver) << ",\n"
+      << "  \"linear_solver_reason\": "
+      << JsonString(result.linear_solver_reason) << ",\n"
+      << "  \"termination\": "
+      << JsonString(ceres::TerminationTypeToString(s.termination_type)) << ",\n"
+      << "  \"converged\": " << (result.converged ? "true" : "false") << ",\n"
+      << "  \"iterations\": " << result.total_iterations << ",\n"
+      << "  \"outer_rounds\": " << options.outer_rounds << ",\n"
+      << "  \"initial_cost\": " << FormatNumber(s.initial_cost) << ",\n"
+      << "  \"final_cost\": " << FormatNumber(s.final_cost) << ",\n"
+      << "  \"num_residual_blocks\": " << s.num_residual_blocks << ",\n"
+      << "  \"num_parameters\": " << s.num_parameters << ",\n"
+      << "  \"ceres_seconds\": " << FormatNumber(s.total_time_in_seconds)
+      << ",\n"
+      << "  \"total_seconds\": " << FormatNumber(result.solve_seconds) << ",\n"
+      << "  \"num_poses\": " << result.trajectory.size() << ",\n"
+      << "  \"num_landmarks\": " << result.landmarks.size() << ",\n"
+      << "  \"initial_trajectory\": " << JsonString(result.initial_trajectory)
+      << ",\n"
+      << "  \"start_heading_resolved\": "
+      << (result.start_heading.resolved ? "true" : "false") << ",\n"
+      << "  \"start_heading\": " << FormatNumber(result.start_heading.heading)
+      << ",\n"
+      << "  \"range_scale\": " << FormatNumber(result.range_calibration[0])
+      << ",\n"
+      << "  \"range_offset\": " << FormatNumber(result.range_calibration[1])
+      << ",\n"
+      << "  \"quality\": " << JsonString(result.quality.verdict) << ",\n"
+      << "  \"quality_reasons\": [";
+  for (std::size_t i = 0; i < result.quality.reasons.size(); ++i) {
+    out << (i == 0 ? "" : ", ") << JsonString(result.quality.reasons[i]);
+  }
+  out << "],\n  \"residuals\": {";
+  for (std::size_t i = 0; i < result.quality.kinds.size(); ++i) {
+    const ResidualKindQuality& q = result.quality.kinds[i];
+    out << (i == 0 ? "\n" : ",\n") << "    " << JsonString(q.kind)
+        << ": {\"count\": " << q.residuals
+        << ", \"chi2_per_residual\": " << FormatNumber(q.chi2_per_residual)
+        << ", \"share_beyond_3_sigma\": "
+        << FormatNumber(q.share_beyond_3_sigma) << "}";
+  }
+  out << "\n  },\n"
+      << "  \"incremental_every\": " << options.incremental.every << ",\n"
+      << "  \"incremental_updates\": " << result.updates.size() << ",\n"
+      << "  \"update_seconds_mean\": " << FormatNumber(update_mean) << ",\n"
+      << "  \"update_seconds_max\": " << FormatNumber(update_max) << "\n"
+      << "}\n";
+  return FinishWriting(path, &out, error);
+}
+
+}  // namespace rff

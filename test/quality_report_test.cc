@@ -1,0 +1,130 @@
+#include "rff_ceres/quality_report.h"
+
+#include <random>
+
+#include "gmock/gmock.h"
+#include "gtest/gtest.h"
+#include "rff_ceres/simulate.h"
+#include "rff_ceres/slam_solver.h"
+#include "test/synthetic_options.h"
+
+namespace rff {
+namespace {
+
+using ::testing::ElementsAre;
+using ::testing::HasSubstr;
+
+std::vector<double> StandardNormal(int n, double scale, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> normal(0.0, scale);
+  std::vector<double> values(n);
+  for (double& v : values) v = normal(rng);
+  return values;
+}
+
+TEST(QualityReportTest, ResidualsAsTheSigmasPromiseAreOk) {
+  const QualityReport report = AssessQuality(
+      {{"range", StandardNormal(5000, 1.0, 1)},
+       {"odometry", StandardNormal(3000, 0.5, 2)}},
+      SolveFacts());
+  EXPECT_EQ(report.verdict, "ok");
+  EXPECT_TRUE(report.reasons.empty());
+  ASSERT_EQ(report.kinds.size(), 2u);
+  EXPECT_EQ(report.kinds[0].kind, "odometry");  // Sorted by kind.
+  EXPECT_EQ(report.kinds[0].residuals, 3000);
+  EXPECT_NEAR(report.kinds[0].chi2_per_residual, 0.25, 0.02);
+  EXPECT_EQ(report.kinds[1].kind, "range");
+  EXPECT_NEAR(report.kinds[1].chi2_per_residual, 1.0, 0.06);
+  EXPECT_NEAR(report.kinds[1].share_beyond_3_sigma, 0.0027, 0.002);
+}
+
+TEST(QualityReportTest, ResidualsThreeTimesTheirSigmaAreSuspect) {
+  const QualityReport report =
+      AssessQuality({{"range", StandardNormal(2000, 3.0, 3)}}, SolveFacts());
+  EXPECT_EQ(report.verdict, "suspect");
+  ASSERT_EQ(report.reasons.size(), 2u);
+  EXPECT_THAT(report.reasons[0], HasSubstr("range chi2/n "));
+  EXPECT_THAT(report.reasons[1], HasSubstr("% beyond 3 sigma > 5%"));
+  EXPECT_THAT(QualityLine(report), HasSubstr("suspect: range chi2/n "));
+}
+
+TEST(QualityReportTest, OneOutlierAmongFewIsChanceButFourAreNot) {
+  // 1 of 20 is 5% but happens by chance; 4 of 40 almost never does.
+  std::vector<double> few(20, 0.5), more(40, 0.5);
+  few[3] = 4.0;
+  for (int i : {1, 9, 17, 33}) more[i] = -3.5;
+  EXPECT_EQ(AssessQuality({{"landmark prior", few}}, SolveFacts()).verdict,
+            "ok");
+  const QualityReport report =
+      AssessQuality({{"landmark prior", more}}, SolveFacts());
+  EXPECT_THAT(report.reasons,
+              ElementsAre("landmark prior 10% beyond 3 sigma > 5%"));
+}
+
+TEST(QualityReportTest, UnconvergedSolveAndCalibrationAtItsBoundAreSuspect) {
+  SolveFacts facts;
+  facts.converged = false;
+  facts.termination = "NO_CONVERGENCE";
+  facts.range_calibrated = true;
+  facts.range_calibration = {0.5, 0.0};
+  facts.range_calibration_at_bound = true;
+  const QualityReport report = AssessQuality({}, facts);
+  EXPECT_THAT(report.reasons,
+              ElementsAre("the solver stopped before convergence "
+                          "(NO_CONVERGENCE)",
+                          "the range calibration (scale 0.5, offset 0 m) is "
+                          "held by its bound"));
+}
+
+// The paper's protocol solves to an "ok" verdict; the same data with the
+// odometry in a frame turned by pi (a converter's frame bug) cannot be fit
+// and is "suspect".
+TEST(QualityReportTest, SolveOfContradictoryOdometryIsSuspect) {
+  SimulationOptions sim = PaperOptions(12);
+  sim.num_steps = 120;
+  sim.num_landmarks = 20;
+  Dataset dataset;
+  std::string error;
+  ASSERT_TRUE(Simulate(sim, &dataset, &error)) << error;
+  SlamResult good;
+  ASSERT_TRUE(RunSlam(dataset, testing::SyntheticRangeBearingOptions(), &good,
+                      &error))
+      << error;
+  EXPECT_EQ(good.quality.verdict, "ok") << QualityLine(good.quality);
+  for (Odometry& o : dataset.odometry) {
+    o.dx = -o.dx;
+    o.dy = -o.dy;
+  }
+  SlamResult bad;
+  ASSERT_TRUE(RunSlam(dataset, testing::SyntheticRangeBearingOptions(), &bad,
+                      &error))
+      << error;
+  EXPECT_EQ(bad.quality.verdict, "suspect");
+  EXPECT_THAT(QualityLine(bad.quality), HasSubstr("odometry chi2/n"));
+}
+
+// Range self-calibration stays physical on data it cannot explain: the scale
+// ends at its bound, not negative, and the verdict says so.
+TEST(QualityReportTest, RangeCalibrationOfMirroredRunStaysPhysical) {
+  SimulationOptions sim = PaperOptions(13);
+  sim.num_steps = 120;
+  sim.num_landmarks = 20;
+  sim.kind = MeasurementKind::kRange;
+  Dataset dataset;
+  std::string error;
+  ASSERT_TRUE(Simulate(sim, &dataset, &error)) << error;
+  for (Odometry& o : dataset.odometry) {
+    o.dx = -o.dx;
+    o.dy = -o.dy;
+  }
+  SlamOptions options = testing::SyntheticRangeBearingOptions();
+  options.problem.range_calibration.estimate = true;
+  SlamResult result;
+  ASSERT_TRUE(RunSlam(dataset, options, &result, &error)) << error;
+  EXPECT_GE(result.range_calibration[0], kMinRangeScale);
+  EXPECT_LE(result.range_calibration[0], kMaxRangeScale);
+  EXPECT_EQ(result.quality.verdict, "suspect");
+}
+
+}  // namespace
+}  // namespace rff
