@@ -1,8 +1,10 @@
 // rff_simulate: writes a synthetic .rffd dataset (the seed paper's protocol,
-// or the large bearing-only kitti_scale preset). See docs/simulator.md.
+// the large bearing-only kitti_scale preset, or a trajectory drawn from a GP
+// prior, gp_draw). See docs/simulator.md.
 //
 //   rff_simulate --output=s1_rb_L50_o1.rffd --seed=1 --landmarks=50
 //   rff_simulate --output=kitti_scale.rffd --preset=kitti_scale --seed=1
+//   rff_simulate --output=gp.rffd --preset=gp_draw --gp_lengthscale=30
 #include <gflags/gflags.h>
 
 #include <cmath>
@@ -13,13 +15,16 @@
 #include "rff_ceres/io/dataset_io.h"
 #include "rff_ceres/io/text_parser.h"
 #include "rff_ceres/simulate.h"
+#include "rff_ceres/simulate_gp_draw.h"
 #include "rff_ceres/types.h"
 
 DEFINE_string(output, "", "Output .rffd path (required).");
 DEFINE_string(preset, "paper",
-              "paper (the seed paper's protocol) or kitti_scale (3000 poses, "
-              "~4000 landmarks, bearing-only). Flags given explicitly "
-              "override the preset; the defaults below are the paper's.");
+              "paper (the seed paper's protocol), kitti_scale (3000 poses, "
+              "~4000 landmarks, bearing-only) or gp_draw (x, y, theta drawn "
+              "from GPs, 600 poses, no odometry, 4 nearest of 25 landmarks). "
+              "Flags given explicitly override the preset; the defaults "
+              "below are the paper's.");
 DEFINE_uint64(seed, 1, "Random seed; the same seed gives the same file.");
 DEFINE_int32(num_steps, 300, "Number of poses (kitti_scale: 3000).");
 DEFINE_double(dt, 1.0, "Time step in s (kitti_scale: 0.1).");
@@ -51,6 +56,19 @@ DEFINE_int32(min_visible_landmarks, 0,
              "Least number of landmarks every pose sees (kitti_scale: 10).");
 DEFINE_bool(noise_free, false,
             "Add no noise (the sigmas are still written as given).");
+DEFINE_bool(observe_nearest, false,
+            "Observe the nearest landmarks at least --min_range away instead "
+            "of a random sample (gp_draw: true).");
+DEFINE_string(gp_kernel, "matern52",
+              "gp_draw: kernel of x, y and theta (rbf, matern12, matern32, "
+              "matern52, ...).");
+DEFINE_double(gp_lengthscale, 8.0, "gp_draw: lengthscale of x and y in s.");
+DEFINE_double(gp_kernel_variance, 25.0,
+              "gp_draw: kernel variance of x and y in m^2.");
+DEFINE_double(gp_heading_lengthscale, 12.0,
+              "gp_draw: lengthscale of theta in s.");
+DEFINE_double(gp_heading_kernel_variance, 0.25,
+              "gp_draw: kernel variance of theta in rad^2.");
 
 namespace {
 
@@ -67,7 +85,7 @@ int Fail(const std::string& message) {
 
 int main(int argc, char** argv) {
   gflags::SetUsageMessage(
-      "rff_simulate --output=OUT.rffd [--preset=paper|kitti_scale] "
+      "rff_simulate --output=OUT.rffd [--preset=paper|kitti_scale|gp_draw] "
       "[--seed=1] [--kind=range_bearing] [--landmarks=50] ...");
   gflags::ParseCommandLineFlags(&argc, &argv, /*remove_flags=*/true);
   if (argc > 1)
@@ -79,9 +97,11 @@ int main(int argc, char** argv) {
     options = rff::PaperOptions(FLAGS_seed);
   } else if (FLAGS_preset == "kitti_scale") {
     options = rff::KittiScaleOptions(FLAGS_seed);
+  } else if (FLAGS_preset == "gp_draw") {
+    options = rff::GpDrawOptions(FLAGS_seed);
   } else {
     return Fail("unknown --preset '" + FLAGS_preset +
-                "' (expected paper or kitti_scale)");
+                "' (expected paper, kitti_scale or gp_draw)");
   }
   // With the paper preset every flag applies (its defaults are the paper's);
   // with another preset only the flags given on the command line do.
@@ -138,6 +158,29 @@ int main(int argc, char** argv) {
     options.min_visible_landmarks = FLAGS_min_visible_landmarks;
   }
   if (all || Given("noise_free")) options.noise_free = FLAGS_noise_free;
+  if (all || Given("observe_nearest")) {
+    options.observe_nearest = FLAGS_observe_nearest;
+  }
+  // The GP's kernel is used by gp_draw only; the options check its values.
+  for (const char* flag :
+       {"gp_kernel", "gp_lengthscale", "gp_kernel_variance",
+        "gp_heading_lengthscale", "gp_heading_kernel_variance"}) {
+    if (Given(flag) && FLAGS_preset != "gp_draw") {
+      return Fail(std::string("--") + flag +
+                  " applies to --preset=gp_draw only");
+    }
+  }
+  if (Given("gp_kernel")) options.gp_kernel = FLAGS_gp_kernel;
+  if (Given("gp_lengthscale")) options.gp_lengthscale = FLAGS_gp_lengthscale;
+  if (Given("gp_kernel_variance")) {
+    options.gp_kernel_variance = FLAGS_gp_kernel_variance;
+  }
+  if (Given("gp_heading_lengthscale")) {
+    options.gp_heading_lengthscale = FLAGS_gp_heading_lengthscale;
+  }
+  if (Given("gp_heading_kernel_variance")) {
+    options.gp_heading_kernel_variance = FLAGS_gp_heading_kernel_variance;
+  }
 
   rff::Dataset dataset;
   std::string error;

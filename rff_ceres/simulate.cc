@@ -12,6 +12,7 @@
 
 #include "rff_ceres/io/text_parser.h"
 #include "rff_ceres/se2.h"
+#include "rff_ceres/simulate_gp_draw.h"
 
 namespace rff {
 
@@ -82,6 +83,8 @@ std::string TrajectoryShapeName(TrajectoryShape model) {
       return "wandering";
     case TrajectoryShape::kRoad:
       return "road";
+    case TrajectoryShape::kGpDraw:
+      return "gp_draw";
   }
   return "unknown";
 }
@@ -263,9 +266,17 @@ class Controls {
 };
 
 // Integrates the controls exactly over each step (constant speed and turn
-// rate within a step: an arc whose chord points half-way through the turn).
-std::vector<TimedPose> SimulateTrajectory(const SimulationOptions& options) {
+// rate within a step: an arc whose chord points half-way through the turn),
+// or draws the GP trajectory (headings wrapped here).
+bool SimulateTrajectory(const SimulationOptions& options,
+                        std::vector<TimedPose>* trajectory,
+                        std::string* error) {
   SimulationRandom random(StreamSeed(options.seed, Stream::kTrajectory));
+  if (options.trajectory == TrajectoryShape::kGpDraw) {
+    if (!DrawGpTrajectory(options, &random, trajectory, error)) return false;
+    for (TimedPose& pose : *trajectory) pose.theta = WrapAngle(pose.theta);
+    return true;
+  }
   TimedPose pose;
   pose.theta = WrapAngle(random.Uniform(-M_PI, M_PI));
   const Controls controls(options, &random);
@@ -280,7 +291,8 @@ std::vector<TimedPose> SimulateTrajectory(const SimulationOptions& options) {
     pose.t = k * options.dt;
     poses.push_back(pose);
   }
-  return poses;
+  *trajectory = std::move(poses);
+  return true;
 }
 
 bool IsVisible(const SimulationOptions& options, const TimedPose& pose,
@@ -465,6 +477,44 @@ void AddMetadata(const SimulationOptions& options, int num_landmarks,
   add("first_pose_sigma_xy", number(options.first_pose_sigma_xy));
   add("first_pose_sigma_theta", number(options.first_pose_sigma_theta));
   add("noise_free", flag(options.noise_free));
+  // Keys that older files do not have are written only when in use, so
+  // that the paper and kitti_scale files stay byte for byte as they were.
+  if (options.observe_nearest) add("observe_nearest", flag(true));
+  if (options.trajectory == TrajectoryShape::kGpDraw) {
+    add("gp_kernel", options.gp_kernel);
+    add("gp_lengthscale", number(options.gp_lengthscale));
+    add("gp_kernel_variance", number(options.gp_kernel_variance));
+    add("gp_heading_lengthscale", number(options.gp_heading_lengthscale));
+    add("gp_heading_kernel_variance",
+        number(options.gp_heading_kernel_variance));
+    add("truth", GpDrawTruth(options));
+  }
+}
+
+// The `count` candidates nearest to `pose` at least min_range away, nearest
+// first (ties by index), in place at the front of `candidates`; returns how
+// many there are.
+std::size_t SelectNearest(const SimulationOptions& options,
+                          const TimedPose& pose,
+                          const std::vector<Landmark>& landmarks,
+                          std::vector<int>* candidates) {
+  std::vector<std::pair<double, int>> by_distance;
+  for (const int index : *candidates) {
+    const double dx = landmarks[index].x - pose.x;
+    const double dy = landmarks[index].y - pose.y;
+    const double squared = dx * dx + dy * dy;
+    if (squared >= options.min_range * options.min_range) {
+      by_distance.emplace_back(squared, index);
+    }
+  }
+  const std::size_t count = std::min<std::size_t>(
+      options.observations_per_step, by_distance.size());
+  std::partial_sort(by_distance.begin(), by_distance.begin() + count,
+                    by_distance.end());
+  for (std::size_t j = 0; j < count; ++j) {
+    (*candidates)[j] = by_distance[j].second;
+  }
+  return count;
 }
 
 }  // namespace
@@ -490,6 +540,10 @@ bool ValidateSimulationOptions(const SimulationOptions& o, std::string* error) {
   check.Positive("first_pose_sigma_xy", o.first_pose_sigma_xy);
   check.Positive("first_pose_sigma_theta", o.first_pose_sigma_theta);
   if (!check.ok()) return false;
+  if (o.trajectory == TrajectoryShape::kGpDraw &&
+      !ValidateGpDrawOptions(o, error)) {
+    return false;
+  }
   const bool preset_is_word =
       !o.preset.empty() && o.preset.size() <= 64 &&
       std::all_of(o.preset.begin(), o.preset.end(), [](char c) {
@@ -527,7 +581,8 @@ bool Simulate(const SimulationOptions& options, Dataset* dataset,
               std::string* error) {
   if (!ValidateSimulationOptions(options, error)) return false;
   *dataset = Dataset();
-  const std::vector<TimedPose> poses = SimulateTrajectory(options);
+  std::vector<TimedPose> poses;
+  if (!SimulateTrajectory(options, &poses, error)) return false;
 
   const bool use_visibility = options.sensor_range > 0.0;
   std::vector<std::vector<int>> visible;
@@ -571,14 +626,23 @@ bool Simulate(const SimulationOptions& options, Dataset* dataset,
   std::iota(candidates.begin(), candidates.end(), 0);
   for (std::size_t k = 0; k < poses.size(); ++k) {
     const TimedPose& pose = poses[k];
-    if (use_visibility) candidates = visible[k];
-    // A partial Fisher-Yates shuffle: the first `count` entries are a
-    // uniformly random ordered sample without replacement.
+    if (use_visibility) {
+      candidates = visible[k];
+    } else if (options.observe_nearest) {
+      std::iota(candidates.begin(), candidates.end(), 0);
+    }
+    // Nearest first, or a partial Fisher-Yates shuffle: the first `count`
+    // entries are a uniformly random ordered sample without replacement.
     const std::size_t count =
-        std::min<std::size_t>(options.observations_per_step, candidates.size());
+        options.observe_nearest
+            ? SelectNearest(options, pose, landmarks, &candidates)
+            : std::min<std::size_t>(options.observations_per_step,
+                                    candidates.size());
     for (std::size_t j = 0; j < count; ++j) {
-      std::swap(candidates[j],
-                candidates[j + selection.Index(candidates.size() - j)]);
+      if (!options.observe_nearest) {
+        std::swap(candidates[j],
+                  candidates[j + selection.Index(candidates.size() - j)]);
+      }
       const Landmark& landmark = landmarks[candidates[j]];
       const double dx = landmark.x - pose.x;
       const double dy = landmark.y - pose.y;

@@ -36,9 +36,12 @@ enum class TrajectoryShape {
   // Car on a road: near-constant speed, long straight stretches joined by
   // smooth turns of 30 to 90 degrees.
   kRoad,
+  // x(t), y(t) and theta(t) drawn from independent zero-mean Gaussian
+  // processes with the gp_* kernels below (simulate_gp_draw.h).
+  kGpDraw,
 };
 
-// "wandering", "road".
+// "wandering", "road", "gp_draw".
 std::string TrajectoryShapeName(TrajectoryShape model);
 
 // Every knob of the simulator. The defaults are the seed paper's protocol
@@ -46,7 +49,8 @@ std::string TrajectoryShapeName(TrajectoryShape model);
 // bearing sigma 2 deg, landmark priors of 5 m, odometry 0.05 m / 0.01 rad).
 struct SimulationOptions {
   std::uint64_t seed = 1;
-  // Preset the options came from ("paper" or "kitti_scale"); metadata only.
+  // Preset the options came from ("paper", "kitti_scale" or "gp_draw");
+  // metadata only.
   std::string preset = "paper";
 
   // Trajectory: poses at t = 0, dt, ..., (num_steps - 1) dt.
@@ -54,6 +58,16 @@ struct SimulationOptions {
   int num_steps = 300;
   double dt = 1.0;     // s
   double speed = 1.0;  // mean forward speed, m/s
+
+  // kGpDraw only: the kernel of every coordinate (a name of CreateKernel,
+  // e.g. "rbf" or "matern52"), the lengthscale (s) and variance (m^2) of x
+  // and y, and those of theta (s, rad^2). The "# truth:" metadata line
+  // records them.
+  std::string gp_kernel = "matern52";
+  double gp_lengthscale = 8.0;
+  double gp_kernel_variance = 25.0;
+  double gp_heading_lengthscale = 12.0;
+  double gp_heading_kernel_variance = 0.25;
 
   // Landmarks: ids 0 .. num_landmarks - 1 (plus any that the visibility
   // guarantee below adds).
@@ -73,6 +87,10 @@ struct SimulationOptions {
   // landmarks, or among the visible ones when sensor_range > 0 (then fewer
   // if fewer are visible). Clamped to the number of candidates.
   int observations_per_step = 4;
+  // Observe the observations_per_step nearest candidates at least min_range
+  // away (ties by id) instead of a random sample: a sensor that reports
+  // what is close. Applies min_range with or without a sensor_range.
+  bool observe_nearest = false;
 
   // Visibility model, used when sensor_range > 0: a landmark is visible from
   // a pose when its distance lies in [min_range, sensor_range] and its
@@ -106,6 +124,8 @@ SimulationOptions PaperOptions(std::uint64_t seed);
 // at about 10 m/s, about 4000 landmarks, a 90 degree field of view out to
 // 40 m, at least 10 landmarks seen and up to 15 observed per pose.
 SimulationOptions KittiScaleOptions(std::uint64_t seed);
+
+// The "gp_draw" preset is GpDrawOptions in simulate_gp_draw.h.
 
 // Checks every option; on failure `error` names the option, its value and
 // the allowed range.
