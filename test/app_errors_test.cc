@@ -325,6 +325,52 @@ const AppCase kAppCases[] = {
      "rff_dead_reckoning: error: {dir}/single.rffd: the dataset has no "
      "ODOM records",
      "{dir}/dr.tum"},
+    // rff_perturb.
+    {"PerturbNoInput", "{bin}/rff_perturb --output={dir}/p.rffd",
+     "rff_perturb: error: --input is required", "{dir}/p.rffd"},
+    {"PerturbNoOutput", "{bin}/rff_perturb --input={dir}/valid.rffd",
+     "rff_perturb: error: --output is required", ""},
+    {"PerturbUnexpectedArgument",
+     "{bin}/rff_perturb --input={dir}/valid.rffd --output={dir}/p.rffd extra",
+     "rff_perturb: error: unexpected argument 'extra'", "{dir}/p.rffd"},
+    {"PerturbOutputIsInput",
+     "{bin}/rff_perturb --input={dir}/valid.rffd --output={dir}/valid.rffd "
+     "--landmark_prior_offset=1",
+     "rff_perturb: error: output {dir}/valid.rffd is the input file "
+     "{dir}/valid.rffd; write the perturbed dataset elsewhere",
+     ""},
+    {"PerturbMissingInput",
+     "{bin}/rff_perturb --input={dir}/none.rffd --output={dir}/p.rffd",
+     "rff_perturb: error: {dir}/none.rffd: cannot open for reading",
+     "{dir}/p.rffd"},
+    {"PerturbBadLine",
+     "{bin}/rff_perturb --input={dir}/bad.rffd --output={dir}/p.rffd",
+     "rff_perturb: error: {dir}/bad.rffd:3: RANGE needs 4 fields, got 3",
+     "{dir}/p.rffd"},
+    {"PerturbNegativeOffset",
+     "{bin}/rff_perturb --input={dir}/valid.rffd --output={dir}/p.rffd "
+     "--landmark_prior_offset=-1",
+     "rff_perturb: error: landmark_prior_offset must be in [0, 1e+06] m, "
+     "got -1",
+     "{dir}/p.rffd"},
+    {"PerturbNaNHeadingOffset",
+     "{bin}/rff_perturb --input={dir}/valid.rffd --output={dir}/p.rffd "
+     "--start_heading_offset_deg=nan",
+     "rff_perturb: error: start_heading_offset_deg must be in [-360, 360] "
+     "deg, got nan",
+     "{dir}/p.rffd"},
+    {"PerturbZeroHeadingSigma",
+     "{bin}/rff_perturb --input={dir}/valid.rffd --output={dir}/p.rffd "
+     "--start_heading_sigma=0",
+     "rff_perturb: error: start_heading_sigma must be in (0, 1e+06] rad, "
+     "got 0",
+     "{dir}/p.rffd"},
+    {"PerturbOffsetWithoutLandmarkPriors",
+     "{bin}/rff_perturb --input={dir}/single.rffd --output={dir}/p.rffd "
+     "--landmark_prior_offset=1",
+     "rff_perturb: error: {dir}/single.rffd: landmark_prior_offset=1 seed=1 "
+     "moves the landmark priors, but there is no PRIOR_LANDMARK record",
+     "{dir}/p.rffd"},
 };
 
 INSTANTIATE_TEST_SUITE_P(Cases, AppErrorTest, ::testing::ValuesIn(kAppCases),

@@ -1,0 +1,154 @@
+#include "rff_ceres/perturb.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <string>
+#include <system_error>
+
+#include "rff_ceres/io/dataset_io.h"
+#include "rff_ceres/io/text_parser.h"
+#include "rff_ceres/simulate.h"
+
+namespace rff {
+namespace {
+
+constexpr double kDegree = M_PI / 180.0;
+
+// The one message style of the option checks.
+bool InRange(bool in_range, const char* name, double value, const char* range,
+             std::string* error) {
+  if (in_range) return true;
+  *error = std::string(name) + " must be in " + range + ", got " +
+           FormatNumber(value);
+  return false;
+}
+
+// "start_heading_offset_deg=90 start_heading_sigma=3.14 seed=7": the
+// heading request, for the metadata line and the error messages alike.
+std::string HeadingRequest(const PerturbOptions& options) {
+  std::string request = "start_heading_offset_deg=" +
+                        FormatNumber(options.start_heading_offset_deg);
+  if (options.start_heading_sigma) {
+    request +=
+        " start_heading_sigma=" + FormatNumber(*options.start_heading_sigma);
+  }
+  return request + " seed=" + std::to_string(options.seed);
+}
+
+std::string LandmarkRequest(const PerturbOptions& options) {
+  return "landmark_prior_offset=" +
+         FormatNumber(options.landmark_prior_offset) +
+         " seed=" + std::to_string(options.seed);
+}
+
+// Every prior mean moves by an independent draw per axis, in id order (the
+// reader's order), x before y, so that a seed means the same offsets.
+void OffsetLandmarkPriors(const PerturbOptions& options, Dataset* dataset) {
+  const double offset = options.landmark_prior_offset;
+  SimulationRandom random(options.seed);
+  for (LandmarkPrior& prior : dataset->landmark_priors) {
+    prior.x += offset * random.Normal();
+    prior.y += offset * random.Normal();
+    prior.sigma = std::max(prior.sigma, offset);
+  }
+  const std::string offset_text = FormatNumber(offset);
+  dataset->metadata.emplace_back(
+      "perturbation", LandmarkRequest(options) + ": " +
+                          std::to_string(dataset->landmark_priors.size()) +
+                          " PRIOR_LANDMARK means moved by N(0, " + offset_text +
+                          "^2) per axis, sigmas raised to at least " +
+                          offset_text);
+}
+
+// The earliest PRIOR_POSE (the first of equal times) is the start.
+void RotateStartHeading(const PerturbOptions& options, Dataset* dataset) {
+  PosePrior& start = *std::min_element(
+      dataset->pose_priors.begin(), dataset->pose_priors.end(),
+      [](const PosePrior& a, const PosePrior& b) {
+        return a.pose.t < b.pose.t;
+      });
+  const double old_theta = start.pose.theta;
+  const double old_sigma = start.sigma_theta;
+  start.pose.theta =
+      WrapAngle(old_theta + options.start_heading_offset_deg * kDegree);
+  if (options.start_heading_sigma) {
+    start.sigma_theta = *options.start_heading_sigma;
+  }
+  dataset->metadata.emplace_back(
+      "perturbation",
+      HeadingRequest(options) + ": PRIOR_POSE at t=" +
+          FormatNumber(start.pose.t) + " theta " + FormatNumber(old_theta) +
+          " -> " + FormatNumber(start.pose.theta) + ", sigma_theta " +
+          FormatNumber(old_sigma) + " -> " + FormatNumber(start.sigma_theta));
+}
+
+bool SameFile(const std::string& a, const std::string& b) {
+  std::error_code ignored;  // A path that does not exist is no other file.
+  return a == b || std::filesystem::equivalent(a, b, ignored);
+}
+
+}  // namespace
+
+bool ValidatePerturbOptions(const PerturbOptions& o, std::string* error) {
+  // Written as "inside" tests so that NaN fails every one of them.
+  const double offset = o.landmark_prior_offset;
+  const double heading = o.start_heading_offset_deg;
+  return InRange(offset >= 0.0 && offset <= kMaxPerturbMagnitude,
+                 "landmark_prior_offset", offset, "[0, 1e+06] m", error) &&
+         InRange(heading >= -360.0 && heading <= 360.0,
+                 "start_heading_offset_deg", heading, "[-360, 360] deg",
+                 error) &&
+         (!o.start_heading_sigma ||
+          InRange(*o.start_heading_sigma > 0.0 &&
+                      *o.start_heading_sigma <= kMaxPerturbMagnitude,
+                  "start_heading_sigma", *o.start_heading_sigma,
+                  "(0, 1e+06] rad", error));
+}
+
+bool ChangesLandmarkPriors(const PerturbOptions& options) {
+  return options.landmark_prior_offset > 0.0;
+}
+
+bool ChangesStartHeading(const PerturbOptions& options) {
+  return options.start_heading_offset_deg != 0.0 ||
+         options.start_heading_sigma.has_value();
+}
+
+bool PerturbDataset(const PerturbOptions& options, Dataset* dataset,
+                    std::string* error) {
+  if (!ValidatePerturbOptions(options, error)) return false;
+  if (ChangesStartHeading(options) && dataset->pose_priors.empty()) {
+    *error = HeadingRequest(options) +
+             " changes the start heading, but there is no PRIOR_POSE record";
+    return false;
+  }
+  if (ChangesLandmarkPriors(options) && dataset->landmark_priors.empty()) {
+    *error = LandmarkRequest(options) +
+             " moves the landmark priors, but there is no PRIOR_LANDMARK "
+             "record";
+    return false;
+  }
+  if (ChangesLandmarkPriors(options)) OffsetLandmarkPriors(options, dataset);
+  if (ChangesStartHeading(options)) RotateStartHeading(options, dataset);
+  return true;
+}
+
+bool PerturbFile(const std::string& input, const std::string& output,
+                 const PerturbOptions& options, std::string* error) {
+  if (!ValidatePerturbOptions(options, error)) return false;
+  if (SameFile(input, output)) {
+    *error = "output " + output + " is the input file " + input +
+             "; write the perturbed dataset elsewhere";
+    return false;
+  }
+  Dataset dataset;
+  if (!ReadDataset(input, &dataset, error)) return false;
+  if (!PerturbDataset(options, &dataset, error)) {
+    *error = input + ": " + *error;
+    return false;
+  }
+  return WriteDataset(dataset, output, error);
+}
+
+}  // namespace rff
