@@ -1,9 +1,11 @@
 // rff_simulate: writes a synthetic .rffd dataset (the seed paper's protocol,
-// the large bearing-only kitti_scale preset, or a trajectory drawn from a GP
-// prior, gp_draw). See docs/simulator.md.
+// the large bearing-only kitti_scale preset, a ground robot with a laser,
+// laser_10hz, or a trajectory drawn from a GP prior, gp_draw). See
+// docs/simulator.md.
 //
 //   rff_simulate --output=s1_rb_L50_o1.rffd --seed=1 --landmarks=50
 //   rff_simulate --output=kitti_scale.rffd --preset=kitti_scale --seed=1
+//   rff_simulate --output=laser.rffd --preset=laser_10hz --seed=1
 //   rff_simulate --output=gp.rffd --preset=gp_draw --gp_lengthscale=30
 #include <gflags/gflags.h>
 
@@ -21,7 +23,9 @@
 DEFINE_string(output, "", "Output .rffd path (required).");
 DEFINE_string(preset, "paper",
               "paper (the seed paper's protocol), kitti_scale (3000 poses, "
-              "~4000 landmarks, bearing-only) or gp_draw (x, y, theta drawn "
+              "~4000 landmarks, bearing-only), laser_10hz (12000 poses at "
+              "10 Hz, range-bearing to the 6 nearest landmarks in a 270 "
+              "degree, 20 m view, odometry) or gp_draw (x, y, theta drawn "
               "from GPs, 600 poses, no odometry, 4 nearest of 25 landmarks). "
               "Flags given explicitly override the preset; the defaults "
               "below are the paper's.");
@@ -85,7 +89,8 @@ int Fail(const std::string& message) {
 
 int main(int argc, char** argv) {
   gflags::SetUsageMessage(
-      "rff_simulate --output=OUT.rffd [--preset=paper|kitti_scale|gp_draw] "
+      "rff_simulate --output=OUT.rffd "
+      "[--preset=paper|kitti_scale|laser_10hz|gp_draw] "
       "[--seed=1] [--kind=range_bearing] [--landmarks=50] ...");
   gflags::ParseCommandLineFlags(&argc, &argv, /*remove_flags=*/true);
   if (argc > 1)
@@ -97,11 +102,13 @@ int main(int argc, char** argv) {
     options = rff::PaperOptions(FLAGS_seed);
   } else if (FLAGS_preset == "kitti_scale") {
     options = rff::KittiScaleOptions(FLAGS_seed);
+  } else if (FLAGS_preset == "laser_10hz") {
+    options = rff::Laser10HzOptions(FLAGS_seed);
   } else if (FLAGS_preset == "gp_draw") {
     options = rff::GpDrawOptions(FLAGS_seed);
   } else {
     return Fail("unknown --preset '" + FLAGS_preset +
-                "' (expected paper, kitti_scale or gp_draw)");
+                "' (expected paper, kitti_scale, laser_10hz or gp_draw)");
   }
   // With the paper preset every flag applies (its defaults are the paper's);
   // with another preset only the flags given on the command line do.

@@ -49,8 +49,8 @@ std::string TrajectoryShapeName(TrajectoryShape model);
 // bearing sigma 2 deg, landmark priors of 5 m, odometry 0.05 m / 0.01 rad).
 struct SimulationOptions {
   std::uint64_t seed = 1;
-  // Preset the options came from ("paper", "kitti_scale" or "gp_draw");
-  // metadata only.
+  // Preset the options came from ("paper", "kitti_scale", "laser_10hz" or
+  // "gp_draw"); metadata only.
   std::string preset = "paper";
 
   // Trajectory: poses at t = 0, dt, ..., (num_steps - 1) dt.
@@ -124,6 +124,14 @@ SimulationOptions PaperOptions(std::uint64_t seed);
 // at about 10 m/s, about 4000 landmarks, a 90 degree field of view out to
 // 40 m, at least 10 landmarks seen and up to 15 observed per pose.
 SimulationOptions KittiScaleOptions(std::uint64_t seed);
+
+// A ground robot with a laser scanner: 20 minutes at 10 Hz (12000 poses) on
+// the wandering path at about 1 m/s, wheel odometry every step (5 mm and
+// 0.001 rad per step: dead reckoning ends a few metres off), range-bearing
+// to the 6 nearest landmarks in a 270 degree view from 1 to 20 m (0.05 m,
+// 0.5 deg), about 150 landmarks of which every pose sees at least 4, and
+// landmark priors 1 m off.
+SimulationOptions Laser10HzOptions(std::uint64_t seed);
 
 // The "gp_draw" preset is GpDrawOptions in simulate_gp_draw.h.
 

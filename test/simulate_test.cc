@@ -116,9 +116,9 @@ TEST(SimulationRandomTest, IndexIsInRangeAndCoversIt) {
 
 TEST(SimulateTest, SameSeedGivesIdenticalBytesAndOtherSeedsDiffer) {
   for (const SimulationOptions& base :
-       {PaperOptions(1), KittiScaleOptions(3)}) {
+       {PaperOptions(1), KittiScaleOptions(3), Laser10HzOptions(3)}) {
     SimulationOptions options = base;
-    if (options.preset == "kitti_scale") options.num_steps = 300;
+    if (options.preset != "paper") options.num_steps = 300;
     Dataset a, b, c;
     std::string error;
     ASSERT_TRUE(Simulate(options, &a, &error)) << error;
@@ -426,6 +426,75 @@ TEST(SimulateTest, KittiScalePresetSeesEnoughLandmarksFromEveryPose) {
   }
   EXPECT_NEAR(path, 3000.0, 300.0);
   EXPECT_GT(turning, M_PI / 2.0);
+}
+
+TEST(SimulateTest, Laser10HzPresetIsATwentyMinuteLaserRun) {
+  const SimulationOptions options = Laser10HzOptions(2);
+  std::string error;
+  ASSERT_TRUE(ValidateSimulationOptions(options, &error)) << error;
+  const Dataset d = SimulateAndReparse(options);
+  EXPECT_EQ(Metadata(d, "preset"), "laser_10hz");
+  EXPECT_EQ(Metadata(d, "trajectory"), "wandering");
+  EXPECT_EQ(Metadata(d, "kind"), "range_bearing");
+
+  // 12000 poses at t = 0.1 k: 20 minutes at 10 Hz.
+  ASSERT_EQ(d.ground_truth.size(), 12000u);
+  for (std::size_t k = 0; k < d.ground_truth.size(); ++k) {
+    ASSERT_NEAR(d.ground_truth[k].t, 0.1 * k, 1e-9) << k;
+  }
+  // Wheel odometry between every pair of consecutive poses.
+  ASSERT_EQ(d.odometry.size(), 11999u);
+  for (std::size_t k = 0; k < d.odometry.size(); ++k) {
+    ASSERT_EQ(d.odometry[k].t0, d.ground_truth[k].t);
+    ASSERT_EQ(d.odometry[k].t1, d.ground_truth[k + 1].t);
+    ASSERT_EQ(d.odometry[k].sigma_x, 0.005);
+    ASSERT_EQ(d.odometry[k].sigma_theta, 0.001);
+  }
+  // A ground robot at about 1 m/s (0.5 to 1.5 m/s): about 1.2 km.
+  double path = 0.0;
+  for (std::size_t k = 1; k < d.ground_truth.size(); ++k) {
+    path += std::hypot(d.ground_truth[k].x - d.ground_truth[k - 1].x,
+                       d.ground_truth[k].y - d.ground_truth[k - 1].y);
+  }
+  EXPECT_NEAR(path, 1200.0, 120.0);
+
+  // Every landmark has a prior of sigma 1 m.
+  ASSERT_EQ(d.landmark_priors.size(), d.ground_truth_landmarks.size());
+  for (const LandmarkPrior& prior : d.landmark_priors) {
+    EXPECT_EQ(prior.sigma, 1.0) << prior.id;
+  }
+
+  // Every pose sees (1 to 20 m, within +-135 degrees) at least 4 landmarks
+  // and observes 4 to 6 of them (the nearest), with the laser's sigmas.
+  const auto poses = PosesByTime(d);
+  const auto landmarks = LandmarksById(d);
+  auto in_view = [](const TimedPose& p, const Landmark& l) {
+    const double distance = std::hypot(l.x - p.x, l.y - p.y);
+    const double bearing =
+        WrapAngle(std::atan2(l.y - p.y, l.x - p.x) - p.theta);
+    return distance >= 1.0 && distance <= 20.0 &&
+           std::abs(bearing) <= 0.75 * M_PI + 1e-12;
+  };
+  for (const TimedPose& pose : d.ground_truth) {
+    int visible = 0;
+    for (const Landmark& l : d.ground_truth_landmarks) {
+      visible += in_view(pose, l) ? 1 : 0;
+    }
+    ASSERT_GE(visible, 4) << pose.t;
+  }
+  std::map<double, int> observed;
+  for (const Observation& o : d.observations) {
+    ++observed[o.t];
+    ASSERT_EQ(o.type, ObservationType::kRangeBearing);
+    EXPECT_EQ(o.sigma_range, 0.05);
+    EXPECT_EQ(o.sigma_bearing, 0.5 * M_PI / 180.0);
+    ASSERT_TRUE(in_view(poses.at(o.t), landmarks.at(o.id))) << o.t;
+  }
+  ASSERT_EQ(observed.size(), 12000u);
+  for (const auto& [t, n] : observed) {
+    ASSERT_GE(n, 4) << t;
+    ASSERT_LE(n, 6) << t;
+  }
 }
 
 TEST(SimulateTest, TooFewLandmarksAreToppedUpToTheMinimumVisible) {
