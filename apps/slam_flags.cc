@@ -96,12 +96,12 @@ DEFINE_double(spline_smoothing, 0.98,
               "Smoothing parameter p of the spline mean (De Boor).");
 
 // Problem.
-DEFINE_string(loss, "none",
+DEFINE_string(loss, "cauchy",
               "Robust loss on observations: none, huber, cauchy.");
-DEFINE_double(loss_scale, 1.0, "Robust loss scale, in sigmas.");
-DEFINE_string(odometry_loss, "none",
+DEFINE_double(loss_scale, 2.0, "Robust loss scale, in sigmas.");
+DEFINE_string(odometry_loss, "cauchy",
               "Robust loss on odometry residuals: none, huber, cauchy.");
-DEFINE_double(odometry_loss_scale, 1.0,
+DEFINE_double(odometry_loss_scale, 2.0,
               "Robust odometry loss scale, in sigmas.");
 DEFINE_bool(estimate_range_calibration, false,
             "Estimate a range sensor model scale * distance + offset jointly "
@@ -145,8 +145,9 @@ namespace {
 // True when the user set a kernel hyperparameter (command line or flagfile):
 // "auto" learning then keeps the user's values.
 bool KernelHyperparametersGiven() {
-  for (const char* flag : {"lengthscale", "kernel_variance",
-                           "heading_lengthscale", "heading_kernel_variance"}) {
+  for (const char* flag :
+       {"lengthscale", "kernel_variance", "heading_lengthscale",
+        "heading_kernel_variance", "wnoa_position_qc", "wnoa_heading_qc"}) {
     if (!gflags::GetCommandLineFlagInfoOrDie(flag).is_default) return true;
   }
   return false;

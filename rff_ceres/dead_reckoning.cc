@@ -126,12 +126,7 @@ bool DeadReckon(const Dataset& dataset, const DeadReckoningOptions& options,
     *error = "the dataset has no PRIOR_POSE record to start from";
     return false;
   }
-  result->start =
-      std::min_element(dataset.pose_priors.begin(), dataset.pose_priors.end(),
-                       [](const PosePrior& a, const PosePrior& b) {
-                         return a.pose.t < b.pose.t;
-                       })
-          ->pose;
+  result->start = EarliestPosePrior(dataset).pose;
   std::vector<TimedPose> nodes;
   if (!IntegrateOdometry(result->start, dataset.odometry, options, &nodes,
                          &result->gaps, error)) {

@@ -177,6 +177,17 @@ PoseMap FeatureTrajectory::PoseAt(double t) const {
   return map;
 }
 
+std::vector<TrajectoryModel::PriorScale> FeatureTrajectory::PriorRowScales(
+    const std::vector<double*>& blocks, int num_rows) const {
+  const int offset = static_cast<int>(blocks.front() - weights_.data());
+  const int block = static_cast<int>(
+      std::upper_bound(offsets_.begin(), offsets_.end(), offset) -
+      offsets_.begin() - 1);
+  return std::vector<PriorScale>(
+      num_rows, block % 3 == kTheta ? PriorScale::kHeading
+                                    : PriorScale::kPosition);
+}
+
 void FeatureTrajectory::AddPriorCosts(ceres::Problem* problem, int begin,
                                       int end) {
   for (int b = begin; b < end; ++b) {

@@ -85,6 +85,11 @@ class FeatureTrajectory : public TrajectoryModel {
   using TrajectoryModel::AddPriorCosts;
   void AddPriorCosts(ceres::Problem* problem, int begin, int end) override;
 
+  // Weights of x and y scale with the position kernel's variance, those of
+  // theta with the heading kernel's.
+  std::vector<PriorScale> PriorRowScales(const std::vector<double*>& blocks,
+                                         int num_rows) const override;
+
   double origin() const { return origin_; }
   // The options with the capacity settled (see AutoCapacity).
   const FeatureTrajectoryOptions& options() const { return options_; }

@@ -10,7 +10,9 @@
 #include "ceres/solver.h"
 #include "costs/pose_prior_cost.h"
 #include "rff_ceres/dead_reckoning.h"
+#include "rff_ceres/mean_rotation.h"
 #include "rff_ceres/se2.h"
+#include "rff_ceres/wnoa_trajectory.h"
 
 namespace rff {
 namespace {
@@ -25,14 +27,6 @@ constexpr double kScoreLossScale = 2.0;
 // the model's feature resolution, so the fit follows the pilot's shape.
 constexpr double kFitSigmaXy = 0.05;
 constexpr double kFitSigmaTheta = 0.05;
-
-PosePrior* EarliestPrior(Dataset* dataset) {
-  return &*std::min_element(dataset->pose_priors.begin(),
-                            dataset->pose_priors.end(),
-                            [](const PosePrior& a, const PosePrior& b) {
-                              return a.pose.t < b.pose.t;
-                            });
-}
 
 // Observations grouped by time with the dead-reckoned pose there, for
 // scoring rotations of the dead reckoning about its start.
@@ -70,7 +64,7 @@ Dataset ResolveStartHeading(const Dataset& dataset, StartHeading* report) {
       resolved.landmark_priors.empty()) {
     return resolved;
   }
-  PosePrior* first = EarliestPrior(&resolved);
+  PosePrior* first = &EarliestPosePrior(&resolved);
   report->prior_heading = report->heading = first->pose.theta;
   if (!(first->sigma_theta > kLooseHeadingSigma)) return resolved;
 
@@ -156,6 +150,14 @@ bool BuildPilotTrajectory(const Dataset& dataset,
 
 bool FitModelToPoses(const std::vector<TimedPose>& poses,
                      TrajectoryModel* model, std::string* error) {
+  if (auto* rotation = dynamic_cast<MeanRotationTrajectory*>(model)) {
+    *rotation->mutable_block(0) = 0.0;
+    return FitModelToPoses(poses, rotation->inner(), error);
+  }
+  if (auto* wnoa = dynamic_cast<WnoaTrajectory*>(model)) {
+    wnoa->SetStatesFromPoses(poses);
+    return true;
+  }
   ceres::Problem problem;
   for (int b = 0; b < model->num_blocks(); ++b) {
     problem.AddParameterBlock(model->mutable_block(b), model->block_size(b));

@@ -63,11 +63,7 @@ void OffsetLandmarkPriors(const PerturbOptions& options, Dataset* dataset) {
 
 // The earliest PRIOR_POSE (the first of equal times) is the start.
 void RotateStartHeading(const PerturbOptions& options, Dataset* dataset) {
-  PosePrior& start = *std::min_element(
-      dataset->pose_priors.begin(), dataset->pose_priors.end(),
-      [](const PosePrior& a, const PosePrior& b) {
-        return a.pose.t < b.pose.t;
-      });
+  PosePrior& start = EarliestPosePrior(dataset);
   const double old_theta = start.pose.theta;
   const double old_sigma = start.sigma_theta;
   start.pose.theta =

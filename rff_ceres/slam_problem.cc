@@ -67,27 +67,29 @@ void SlamProblem::AddObservation(const Observation& o) {
   PoseMap map = model_->PoseAt(o.t);
   double* landmark = landmark_block(o.id);
   std::vector<double*> blocks = LocalBlocks({&map}, landmark);
+  const double sigma_range = options_.noise.range * o.sigma_range;
+  const double sigma_bearing = options_.noise.bearing * o.sigma_bearing;
   ceres::CostFunction* cost = nullptr;
   switch (o.type) {
     case ObservationType::kRange:
       if (options_.range_calibration.estimate) {
         blocks.push_back(range_calibration_.data());
-        cost = new CalibratedRangeCost(std::move(map), o.range, o.sigma_range);
+        cost = new CalibratedRangeCost(std::move(map), o.range, sigma_range);
       } else {
-        cost = new RangeCost(std::move(map), o.range, o.sigma_range);
+        cost = new RangeCost(std::move(map), o.range, sigma_range);
       }
       break;
     case ObservationType::kBearing:
-      cost = new BearingCost(std::move(map), o.bearing, o.sigma_bearing);
+      cost = new BearingCost(std::move(map), o.bearing, sigma_bearing);
       break;
     case ObservationType::kRangeBearing:
       if (options_.range_calibration.estimate) {
         blocks.push_back(range_calibration_.data());
         cost = new CalibratedRangeBearingCost(
-            std::move(map), o.range, o.bearing, o.sigma_range, o.sigma_bearing);
+            std::move(map), o.range, o.bearing, sigma_range, sigma_bearing);
       } else {
         cost = new RangeBearingCost(std::move(map), o.range, o.bearing,
-                                    o.sigma_range, o.sigma_bearing);
+                                    sigma_range, sigma_bearing);
       }
       break;
   }
@@ -182,7 +184,8 @@ void SlamProblem::AddOdometry(const PreintegratedOdometry& o) {
   const std::vector<double*> blocks = LocalBlocks({&map0, &map1}, nullptr);
   Remember(problem_->AddResidualBlock(
                new OdometryCost(std::move(map0), std::move(map1), o.motion,
-                                SqrtInformation(o.covariance)),
+                                Eigen::Matrix3d(SqrtInformation(o.covariance) /
+                                                options_.noise.odometry)),
                odometry_loss_.get(), blocks),
            {"odometry", o.t0, o.t1});
 }
@@ -357,17 +360,53 @@ bool SlamProblem::CheckLandmarksDetermined(double max_condition,
   return true;
 }
 
+std::vector<VarianceGroup> SlamProblem::RowGroups(
+    const std::vector<ceres::ResidualBlockId>& ids) {
+  std::vector<VarianceGroup> rows;
+  std::vector<double*> blocks;
+  for (const ceres::ResidualBlockId id : ids) {
+    const int n = problem_->GetCostFunctionForResidualBlock(id)->num_residuals();
+    const auto source = sources_.find(id);
+    if (source == sources_.end()) {  // The trajectory model's own prior.
+      problem_->GetParameterBlocksForResidualBlock(id, &blocks);
+      for (const TrajectoryModel::PriorScale scale :
+           model_->PriorRowScales(blocks, n)) {
+        rows.push_back(scale == TrajectoryModel::PriorScale::kPosition
+                           ? VarianceGroup::kPriorPosition
+                       : scale == TrajectoryModel::PriorScale::kHeading
+                           ? VarianceGroup::kPriorHeading
+                           : VarianceGroup::kFixed);
+      }
+      continue;
+    }
+    const std::string kind = source->second.kind;
+    for (int row = 0; row < n; ++row) {
+      if (kind == "range" || (kind == "range-bearing" && row == 0)) {
+        rows.push_back(VarianceGroup::kRange);
+      } else if (kind == "bearing" || kind == "range-bearing") {
+        rows.push_back(VarianceGroup::kBearing);
+      } else if (kind == "odometry") {
+        rows.push_back(VarianceGroup::kOdometry);
+      } else {
+        rows.push_back(VarianceGroup::kFixed);
+      }
+    }
+  }
+  return rows;
+}
+
 std::shared_ptr<ceres::ParameterBlockOrdering> SlamProblem::Ordering() {
   auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
   for (const LandmarkId id : added_) {
     ordering->AddElementToGroup(landmark_block(id), 0);
   }
   for (int b = 0; b < model_->num_blocks(); ++b) {
-    ordering->AddElementToGroup(model_->mutable_block(b), 1);
+    ordering->AddElementToGroup(model_->mutable_block(b),
+                                model_->IsSharedBlock(b) ? 2 : 1);
   }
   // A group of its own, so its place does not depend on its address.
   if (options_.range_calibration.estimate) {
-    ordering->AddElementToGroup(range_calibration_.data(), 2);
+    ordering->AddElementToGroup(range_calibration_.data(), 3);
   }
   return ordering;
 }

@@ -49,11 +49,39 @@ struct RangeCalibrationOptions {
   double offset_sigma = 1.0;  // m
 };
 
+// Factors on the sigmas of the data by kind: 1 keeps the dataset's own;
+// re-estimated from the residuals when the data show them wrong
+// (variance_components.h).
+struct NoiseScales {
+  double range = 1.0;
+  double bearing = 1.0;
+  double odometry = 1.0;
+};
+
+// What the variance of a residual row scales with: a noise scale of the
+// data, a scale of the trajectory prior, or nothing re-estimated (priors on
+// poses, landmarks and calibration, which state the user's knowledge).
+enum class VarianceGroup {
+  kFixed,
+  kRange,
+  kBearing,
+  kOdometry,
+  kPriorPosition,
+  kPriorHeading
+};
+inline constexpr int kNumVarianceGroups = 6;
+
+// Robust by default: real recordings carry outliers and heavy tails
+// (MRCLAM's commanded velocities, wrong associations); Cauchy at 2 sigma
+// leaves Gaussian data nearly as they are (docs/heldout.md has both).
+inline const LossOptions kDefaultLoss = {"cauchy", 2.0};
+
 struct ProblemOptions {
-  LossOptions loss;
+  LossOptions loss = kDefaultLoss;
+  NoiseScales noise;
   // On the whitened odometry residuals (commanded velocities have heavy
   // tails where the robot lags its commands).
-  LossOptions odometry_loss;
+  LossOptions odometry_loss = kDefaultLoss;
   RangeCalibrationOptions range_calibration;
   bool use_odometry = true;
   // Compose ODOM chains between observation times into one residual each
@@ -127,12 +155,16 @@ class SlamProblem {
   // and "trajectory prior" (the model's own: RFF weights, WNOA motion).
   std::map<std::string, std::vector<double>> WhitenedResidualsByKind();
   bool CheckLandmarksDetermined(double max_condition, std::string* error);
+  // The variance group of every row of the residual blocks `ids`, in order.
+  std::vector<VarianceGroup> RowGroups(
+      const std::vector<ceres::ResidualBlockId>& ids);
   // Information of a landmark given the trajectory, sum of J_l^T J_l over its
   // residuals (through the robust loss if `apply_loss`); zero if unknown.
   Eigen::Matrix2d LandmarkInformation(LandmarkId id, bool apply_loss);
 
   // Landmarks in group 0 (eliminated first), trajectory blocks in group 1,
-  // the range calibration in group 2.
+  // the model's shared blocks (a rotation of its mean) in group 2, the range
+  // calibration in group 3.
   std::shared_ptr<ceres::ParameterBlockOrdering> Ordering();
 
  private:

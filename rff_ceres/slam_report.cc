@@ -28,13 +28,17 @@ void PrintSlamSummary(const SlamOptions& options, const SlamResult& result,
   const FeatureTrajectoryOptions& t = result.trajectory_options;
   if (options.prior == "wnoa") {
     *out << "  model        WNOA (LTV-SDE) prior, Q_c = "
-         << options.wnoa.position_qc << " (x, y), " << options.wnoa.heading_qc
-         << " (theta), " << options.prior_mean << " mean\n";
+         << result.wnoa_options.position_qc << " (x, y), " << result.wnoa_options.heading_qc
+         << " (theta), " << result.prior_mean << " mean\n";
   } else {
     *out << "  model        " << t.family << " features, "
          << t.position_kernel.name << " kernel, D = " << t.num_position_features
          << " (x, y), " << t.num_heading_features << " (theta), "
-         << options.prior_mean << " mean\n";
+         << result.prior_mean << " mean";
+    if (result.prior_mean == "wnoa") {
+      *out << " (a WNOA solve, " << result.mean_seconds << " s)";
+    }
+    *out << "\n";
     *out << "  kernels      lengthscale " << t.position_kernel.lengthscale
          << " s, variance " << t.position_kernel.variance
          << " (x, y); lengthscale " << t.heading_kernel.lengthscale
@@ -102,7 +106,8 @@ bool WriteSummaryJson(const SlamOptions& options, const SlamResult& result,
   UpdateTimes(result, &update_mean, &update_max);
   out << "{\n"
       << "  \"prior\": " << JsonString(options.prior) << ",\n"
-      << "  \"prior_mean\": " << JsonString(options.prior_mean) << ",\n"
+      << "  \"prior_mean\": " << JsonString(result.prior_mean) << ",\n"
+      << "  \"mean_seconds\": " << FormatNumber(result.mean_seconds) << ",\n"
       << "  \"kernel\": " << JsonString(t.position_kernel.name) << ",\n"
       << "  \"heading_kernel\": " << JsonString(t.heading_kernel.name) << ",\n"
       << "  \"lengthscale\": " << FormatNumber(t.position_kernel.lengthscale)
@@ -126,9 +131,9 @@ bool WriteSummaryJson(const SlamOptions& options, const SlamResult& result,
       << "  \"num_features\": " << t.num_position_features << ",\n"
       << "  \"num_heading_features\": " << t.num_heading_features << ",\n"
       << "  \"seed\": " << t.seed << ",\n"
-      << "  \"wnoa_position_qc\": " << FormatNumber(options.wnoa.position_qc)
+      << "  \"wnoa_position_qc\": " << FormatNumber(result.wnoa_options.position_qc)
       << ",\n"
-      << "  \"wnoa_heading_qc\": " << FormatNumber(options.wnoa.heading_qc)
+      << "  \"wnoa_heading_qc\": " << FormatNumber(result.wnoa_options.heading_qc)
       << ",\n"
       << "  \"loss\": " << JsonString(options.problem.loss.name) << ",\n"
       << "  \"odometry_loss\": "

@@ -11,9 +11,11 @@
 #include "rff_ceres/initialization.h"
 #include "rff_ceres/io/text_parser.h"
 #include "rff_ceres/landmark_init.h"
+#include "rff_ceres/mean_rotation.h"
 #include "rff_ceres/mean/prior_mean.h"
 #include "rff_ceres/mean/spline_mean.h"
 #include "rff_ceres/posterior_covariance.h"
+#include "rff_ceres/variance_components.h"
 
 namespace rff {
 namespace {
@@ -143,20 +145,26 @@ std::unique_ptr<TrajectoryModel> CreateTrajectoryModel(
     std::shared_ptr<const MeanFunction> mean, std::string* error) {
   double t_begin, t_end;
   TimeSpan(dataset, &t_begin, &t_end);
+  std::unique_ptr<TrajectoryModel> model;
   if (options.prior == "rff") {
-    return FeatureTrajectory::Create(options.trajectory, std::move(mean),
-                                     t_begin, t_end, error);
-  }
-  if (options.prior == "wnoa") {
+    model = FeatureTrajectory::Create(options.trajectory, mean, t_begin, t_end,
+                                      error);
+  } else if (options.prior == "wnoa") {
     // A state at every distinct observation time, and at both ends of the
     // run so that no query extrapolates.
     std::vector<double> times = {t_begin, t_end};
     for (const Observation& o : dataset.observations) times.push_back(o.t);
-    return WnoaTrajectory::Create(options.wnoa, std::move(mean),
-                                  std::move(times), error);
+    model = WnoaTrajectory::Create(options.wnoa, mean, std::move(times), error);
+  } else {
+    *error = "unknown prior '" + options.prior + "' (expected rff or wnoa)";
+    return nullptr;
   }
-  *error = "unknown prior '" + options.prior + "' (expected rff or wnoa)";
-  return nullptr;
+  if (!model || SettlePriorMean(options, dataset) != "odometry") return model;
+  // Dead reckoning carries the error of its start heading: let it turn.
+  const PosePrior& start = EarliestPosePrior(dataset);
+  return std::make_unique<MeanRotationTrajectory>(
+      std::move(model), std::move(mean), start.pose.t,
+      std::min(start.sigma_theta, kLooseHeadingSigma));
 }
 
 namespace {
@@ -258,6 +266,21 @@ bool CollectTrajectory(const Dataset& dataset, const TrajectoryModel& model,
   return true;
 }
 
+// Where the turn of the mean's start has grown beyond its first-order form
+// (kMaxRotationLinearization), applies it exactly and returns true: the
+// problem is then solved again about the turned mean.
+constexpr double kMaxRotationLinearization = 0.01;  // m
+bool FoldMeanRotation(TrajectoryModel* model, const std::vector<double>& times) {
+  auto* rotation = dynamic_cast<MeanRotationTrajectory*>(model);
+  if (rotation == nullptr ||
+      rotation->LinearizationError(times) <= kMaxRotationLinearization) {
+    return false;
+  }
+  VLOG(1) << "turning the mean by " << rotation->delta() << " rad";
+  rotation->FoldRotation();
+  return true;
+}
+
 // Paper III-B.2: after each solve the prior mean becomes a smoothing spline
 // of the estimate and the weights restart from zero.
 bool SolveBatch(const Dataset& dataset, const SlamOptions& options,
@@ -282,6 +305,10 @@ bool SolveBatch(const Dataset& dataset, const SlamOptions& options,
     if (!CollectTrajectory(dataset, *model, *landmarks, initial_extent, result,
                            error)) {
       return false;
+    }
+    if (FoldMeanRotation(model, OutputTimes(dataset))) {
+      --round;  // The same round again, about the turned mean.
+      continue;
     }
     if (round >= options.outer_rounds) return true;
     std::shared_ptr<const MeanFunction> mean =
@@ -441,6 +468,18 @@ bool SolveIncremental(const Dataset& dataset, const SlamOptions& options,
   return true;
 }
 
+// The WNOA solve the RFF prior starts from: a batch solve of its own with
+// the same problem options.
+bool SolveWnoa(const Dataset& dataset, const SlamOptions& options,
+               SlamResult* solve, std::string* error) {
+  SlamOptions wnoa = options;
+  wnoa.prior = "wnoa";
+  wnoa.prior_mean = "auto";
+  wnoa.outer_rounds = 0;
+  wnoa.compute_covariance = false;
+  return RunSlam(dataset, wnoa, solve, error);
+}
+
 // What the quality report needs from the solve besides the residuals.
 SolveFacts SolveFactsOf(const SlamOptions& options, const SlamResult& result) {
   SolveFacts facts;
@@ -460,12 +499,19 @@ SolveFacts SolveFactsOf(const SlamOptions& options, const SlamResult& result) {
 }
 
 // The blocks start at the fit of the pilot trajectory when there is one
-// (initial_trajectory "auto"), else at zero (the prior mean).
+// (initial_trajectory "auto"), else at zero (the prior mean). A "wnoa" mean
+// is already a solve of the data: it is the start.
 bool InitializeBlocks(const Dataset& start, const SlamOptions& options,
                       TrajectoryModel* model, SlamResult* result,
                       std::string* error) {
   result->initial_trajectory = "mean";
-  if (options.initial_trajectory == "mean") return true;
+  if (!options.initial_poses.empty()) {
+    result->initial_trajectory = "given";
+    return FitModelToPoses(options.initial_poses, model, error);
+  }
+  if (options.initial_trajectory == "mean" || result->prior_mean == "wnoa") {
+    return true;
+  }
   std::vector<TimedPose> pilot;
   std::string why;
   if (!BuildPilotTrajectory(start, options.localization, OutputTimes(start),
@@ -478,7 +524,63 @@ bool InitializeBlocks(const Dataset& start, const SlamOptions& options,
   return true;
 }
 
+// Learns the WNOA Q_c of x, y and theta where the prior is the only model
+// of the motion (no odometry): after the first MAP, each round rescales
+// Q_c by its variance-component factor (variance_components.h, MacKay's
+// fixed point of the Laplace evidence) and solves again from the current
+// estimate, until every factor is within kScaleTolerance of one.
+constexpr int kMaxScaleRounds = 6;
+constexpr double kScaleTolerance = 0.1;
+constexpr double kMaxScaleStep = 10.0;  // Per round, either way.
+bool LearnWnoaScales(const Dataset& dataset,
+                     std::shared_ptr<const MeanFunction> mean,
+                     const ceres::Solver::Options& ceres_options,
+                     double initial_extent, SlamOptions* settled,
+                     std::unique_ptr<TrajectoryModel>* model,
+                     std::map<LandmarkId, Eigen::Vector2d>* landmarks,
+                     std::unique_ptr<SlamProblem>* problem, SlamResult* result,
+                     std::string* error) {
+  for (int round = 0; round < kMaxScaleRounds; ++round) {
+    VarianceComponents components;
+    if (!EstimateVarianceComponents(problem->get(), VarianceComponentOptions(),
+                                    &components, error)) {
+      *error = "learning Q_c: " + *error;
+      return false;
+    }
+    double largest_step = 0.0;
+    auto rescale = [&](VarianceGroup group, double* qc) {
+      const double factor =
+          std::clamp(components[static_cast<int>(group)].factor,
+                     1.0 / kMaxScaleStep, kMaxScaleStep);
+      largest_step = std::max(largest_step, std::abs(std::log(factor)));
+      *qc *= factor;
+    };
+    rescale(VarianceGroup::kPriorPosition, &settled->wnoa.position_qc);
+    rescale(VarianceGroup::kPriorHeading, &settled->wnoa.heading_qc);
+    // Q_c scales the prior only: the states stay where they are.
+    const std::vector<double> states = ModelBlocks(**model);
+    *model = CreateTrajectoryModel(dataset, *settled, mean, error);
+    if (!*model) return false;
+    SetModelBlocks(states, model->get());
+    if (!SolveBatch(dataset, *settled, ceres_options, model->get(), landmarks,
+                    initial_extent, problem, result, error)) {
+      return false;
+    }
+    result->learned = true;
+    if (largest_step < std::log1p(kScaleTolerance)) break;
+  }
+  return true;
+}
+
 }  // namespace
+
+std::string SettlePriorMean(const SlamOptions& options,
+                            const Dataset& dataset) {
+  if (options.prior_mean != "auto") return options.prior_mean;
+  if (dataset.odometry.empty()) return "constant";
+  const bool batch = options.incremental.every == 0;
+  return options.prior == "rff" && batch ? "wnoa" : "odometry";
+}
 
 bool RunSlam(const Dataset& dataset, const SlamOptions& options,
              SlamResult* result, std::string* error) {
@@ -533,16 +635,55 @@ bool RunSlam(const Dataset& dataset, const SlamOptions& options,
     return false;
   }
 
-  // The start (heading, pilot) may come from the data; the prior may not.
+  // Every mean and pilot checks these; before any solve, in the user's terms.
+  if (!CheckLocalizationOptions(options.localization, error)) {
+    *error = "prior mean '" + options.prior_mean + "': " + *error;
+    return false;
+  }
+
+  // The start (heading, pilot) may come from the data.
   const Dataset resolved = ResolveStartHeading(dataset, &result->start_heading);
-  std::shared_ptr<const MeanFunction> mean =
-      BuildPriorMean(options.prior_mean, resolved, options.localization, error);
+  result->prior_mean = SettlePriorMean(options, dataset);
+  if (result->prior_mean == "wnoa" && options.prior != "rff") {
+    *error = "prior mean 'wnoa' is for the rff prior";
+    return false;
+  }
+  // The RFF prior starts from a WNOA solve where nothing else is asked: as
+  // its mean with a "wnoa" mean, else as its initial value.
+  SlamOptions warm = options;
+  const auto mean_start = std::chrono::steady_clock::now();
+  std::shared_ptr<const MeanFunction> mean;
+  if (options.prior == "rff" && incremental.every == 0 &&
+      (result->prior_mean == "wnoa" ||
+       (options.initial_trajectory == "auto" && options.initial_poses.empty()))) {
+    SlamResult wnoa;
+    if (!SolveWnoa(dataset, options, &wnoa, error)) return false;
+    if (result->prior_mean == "wnoa") {
+      mean = std::make_shared<PiecewiseLinearMean>(wnoa.trajectory);
+    } else {
+      warm.initial_poses = wnoa.trajectory;
+      for (const Landmark& l : wnoa.landmarks) {
+        warm.initial_landmarks[l.id] = Eigen::Vector2d(l.x, l.y);
+      }
+    }
+  }
+  if (!mean) {
+    mean = BuildPriorMean(result->prior_mean, resolved, options.localization,
+                          error);
+  }
   if (!mean) return false;
+  result->mean_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() -
+                                    mean_start)
+          .count();
   std::unique_ptr<TrajectoryModel> model =
       CreateTrajectoryModel(dataset, options, mean, error);
   if (!model) return false;
-  if (!InitializeBlocks(resolved, options, model.get(), result, error)) {
+  if (!InitializeBlocks(resolved, warm, model.get(), result, error)) {
     return false;
+  }
+  if (options.initial_poses.empty() && !warm.initial_poses.empty()) {
+    result->initial_trajectory = "wnoa";
   }
 
   // The initial scene: the initial trajectory, the landmarks' initial
@@ -554,6 +695,9 @@ bool RunSlam(const Dataset& dataset, const SlamOptions& options,
           resolved, [&](double t) { return model->Pose(t); }, &landmarks,
           error)) {
     return false;
+  }
+  for (const auto& [id, position] : warm.initial_landmarks) {
+    if (landmarks.count(id)) landmarks[id] = position;
   }
   std::vector<TimedPose> initial;
   for (const double t : OutputTimes(dataset)) {
@@ -583,7 +727,7 @@ bool RunSlam(const Dataset& dataset, const SlamOptions& options,
     if (!model || !FitModelToPoses(initial, model.get(), error)) return false;
   }
   if (const auto* features =
-          dynamic_cast<const FeatureTrajectory*>(model.get())) {
+          dynamic_cast<const FeatureTrajectory*>(InnerModel(model.get()))) {
     result->trajectory_options = features->options();
   }
   double initial_extent = Extent(initial, landmarks);
@@ -611,7 +755,13 @@ bool RunSlam(const Dataset& dataset, const SlamOptions& options,
   } else if (!SolveBatch(dataset, settled, ceres_options, model.get(),
                          &landmarks, initial_extent, &problem, result, error)) {
     return false;
+  } else if (options.prior == "wnoa" && search &&
+             !LearnWnoaScales(dataset, mean, ceres_options, initial_extent,
+                              &settled, &model, &landmarks, &problem, result,
+                              error)) {
+    return false;
   }
+  result->wnoa_options = settled.wnoa;
   if (!problem->CheckLandmarksDetermined(1e12, error)) return false;
   result->quality = AssessQuality(problem->WhitenedResidualsByKind(),
                                   SolveFactsOf(settled, *result));

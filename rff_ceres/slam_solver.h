@@ -5,6 +5,7 @@
 #ifndef RFF_CERES_SLAM_SOLVER_H_
 #define RFF_CERES_SLAM_SOLVER_H_
 
+#include <map>
 #include <memory>
 #include <ostream>
 #include <string>
@@ -57,10 +58,17 @@ struct SlamOptions {
   // Trajectory prior: "rff" (weight-space features, FeatureTrajectory) or
   // "wnoa" (LTV-SDE states, WnoaTrajectory).
   std::string prior = "rff";
+  // Prior mean (prior_mean.h). "auto" settles per dataset (SettlePriorMean):
+  // for the RFF prior in batch mode with odometry, "wnoa".
   std::string prior_mean = "auto";
   // Initial value of the blocks: "auto" fits them to a localisation pilot
   // (initialization.h) when one can be built; "mean" starts at the mean.
   std::string initial_trajectory = "auto";
+  // A warm start that overrides initial_trajectory: the blocks are fitted to
+  // these poses (sorted by time) and these landmarks start here (the others
+  // are initialised from their observations as usual).
+  std::vector<TimedPose> initial_poses;
+  std::map<LandmarkId, Eigen::Vector2d> initial_landmarks;
   // Tuning of the "localization" mean (docs/prior_means.md).
   LocalizationOptions localization;
   FeatureTrajectoryOptions trajectory;
@@ -107,19 +115,31 @@ struct SlamResult {
   bool converged = false;                  // Ceres reported CONVERGENCE.
   std::vector<IncrementalUpdate> updates;  // Incremental mode only.
   StartHeading start_heading;
-  // The RFF model as solved: learned kernels, settled capacity.
+  // The models as solved: learned kernels and settled capacity (RFF),
+  // learned Q_c (WNOA).
   FeatureTrajectoryOptions trajectory_options;
+  WnoaOptions wnoa_options;
   bool learned = false;
   LearningReport learning;
   // The linear solver used and why ("auto" settles on one per problem).
   std::string linear_solver;
   std::string linear_solver_reason;
   std::string initial_trajectory;  // "localization" (the pilot) or "mean".
+  std::string prior_mean;          // The mean "auto" settled on.
+  double mean_seconds = 0.0;       // Time to build the mean (a "wnoa" solve).
   // (scale, offset) of the range sensor; (1, 0) unless estimated.
   Eigen::Vector2d range_calibration = Eigen::Vector2d(1.0, 0.0);
   // The whitened residuals at the solution and the verdict on them.
   QualityReport quality;
 };
+
+// The prior mean "auto" stands for on `dataset`: for the RFF prior in batch
+// mode with odometry "wnoa" (the LTV-SDE posterior mean: dead reckoning's
+// drift grows along the run, which a non-stationary prior models and a
+// stationary kernel about dead reckoning does not; docs/prior_means.md has
+// the held-out table), else "odometry" with odometry and "constant" without.
+// Any other name is returned as it is.
+std::string SettlePriorMean(const SlamOptions& options, const Dataset& dataset);
 
 // Runs the solve. Returns false with a message on bad options or input, and
 // when the solve fails or its result is not finite (divergence).

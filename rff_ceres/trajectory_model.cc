@@ -1,5 +1,6 @@
 #include "rff_ceres/trajectory_model.h"
 
+#include <algorithm>
 #include <map>
 
 namespace rff {
@@ -8,6 +9,25 @@ Eigen::Vector3d TrajectoryModel::Pose(double t) const {
   std::vector<const double*> blocks(num_blocks());
   for (int i = 0; i < num_blocks(); ++i) blocks[i] = block(i);
   return EvaluatePose(PoseAt(t), blocks.data());
+}
+
+std::vector<double> ModelBlocks(const TrajectoryModel& model) {
+  std::vector<double> values;
+  for (int b = 0; b < model.num_blocks(); ++b) {
+    values.insert(values.end(), model.block(b),
+                  model.block(b) + model.block_size(b));
+  }
+  return values;
+}
+
+void SetModelBlocks(const std::vector<double>& values,
+                    TrajectoryModel* model) {
+  std::size_t offset = 0;
+  for (int b = 0; b < model->num_blocks(); ++b) {
+    std::copy_n(values.begin() + offset, model->block_size(b),
+                model->mutable_block(b));
+    offset += model->block_size(b);
+  }
 }
 
 std::vector<double*> BindPoseMaps(TrajectoryModel* model,

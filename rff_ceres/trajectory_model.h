@@ -45,10 +45,27 @@ class TrajectoryModel {
   virtual const MeanFunction& mean() const = 0;
   virtual void set_mean(std::shared_ptr<const MeanFunction> mean) = 0;
 
+  // The scale of the prior each row of a prior residual over `blocks` (as
+  // AddPriorCosts adds it) belongs to, for re-estimating it from the data
+  // (variance_components.h): the position or heading kernel variance / Q_c,
+  // or none for terms whose scale is fixed (priors on a start, a rotation).
+  enum class PriorScale { kNone, kPosition, kHeading };
+  virtual std::vector<PriorScale> PriorRowScales(
+      const std::vector<double*>& blocks, int num_rows) const = 0;
+
+  // Whether every pose depends on the block (not a block local in time):
+  // the problem orders such blocks in a group of their own, so that their
+  // place in the solve does not depend on their address.
+  virtual bool IsSharedBlock(int /*block*/) const { return false; }
+
   // Heading and position at t with the current block values (heading not
   // wrapped: the model's heading is a continuous function of time).
   Eigen::Vector3d Pose(double t) const;
 };
+
+// Every block's values in block order, and back (same model structure).
+std::vector<double> ModelBlocks(const TrajectoryModel& model);
+void SetModelBlocks(const std::vector<double>& values, TrajectoryModel* model);
 
 // The parameter blocks a cost over `maps` takes, in order of first use; the
 // maps' model block ids are rewritten to indices into that list, in place.

@@ -4,6 +4,7 @@
 #ifndef RFF_CERES_TYPES_H_
 #define RFF_CERES_TYPES_H_
 
+#include <algorithm>
 #include <cstdint>
 #include <string>
 #include <utility>
@@ -89,6 +90,20 @@ struct Dataset {
   std::vector<TimedPose> ground_truth;
   std::vector<Landmark> ground_truth_landmarks;
 };
+
+// The earliest PRIOR_POSE (the first of equal times): where the run starts.
+// The dataset must have one (the reader guarantees it).
+inline const PosePrior& EarliestPosePrior(const Dataset& dataset) {
+  return *std::min_element(dataset.pose_priors.begin(),
+                           dataset.pose_priors.end(),
+                           [](const PosePrior& a, const PosePrior& b) {
+                             return a.pose.t < b.pose.t;
+                           });
+}
+inline PosePrior& EarliestPosePrior(Dataset* dataset) {
+  return const_cast<PosePrior&>(
+      EarliestPosePrior(static_cast<const Dataset&>(*dataset)));
+}
 
 }  // namespace rff
 

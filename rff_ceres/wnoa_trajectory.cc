@@ -95,6 +95,32 @@ const std::vector<double>& WnoaTrajectory::state_times() const {
   return times_;
 }
 
+void WnoaTrajectory::SetStatesFromPoses(const std::vector<TimedPose>& poses) {
+  const PiecewiseLinearMean target(poses);
+  const int n = static_cast<int>(times_.size());
+  std::vector<Eigen::Vector3d> deviation(n);
+  for (int i = 0; i < n; ++i) {
+    deviation[i] = target.Evaluate(times_[i]) - mean_->Evaluate(times_[i]);
+    deviation[i].z() = WrapAngle(deviation[i].z());
+    if (i > 0) {  // Continuous heading deviation between states.
+      deviation[i].z() = deviation[i - 1].z() +
+                         WrapAngle(deviation[i].z() - deviation[i - 1].z());
+    }
+  }
+  for (int i = 0; i < n; ++i) {
+    const int before = std::max(i - 1, 0), after = std::min(i + 1, n - 1);
+    const double dt = times_[after] - times_[before];
+    const Eigen::Vector3d velocity =
+        dt > 0.0 ? Eigen::Vector3d((deviation[after] - deviation[before]) / dt)
+                 : Eigen::Vector3d::Zero();
+    double* state = mutable_block(i);
+    for (int c = 0; c < 3; ++c) {
+      state[c] = deviation[i][c];
+      state[3 + c] = velocity[c];
+    }
+  }
+}
+
 void WnoaTrajectory::InterpolationMatrices(double elapsed, double dt,
                                            Eigen::Matrix2d* lambda,
                                            Eigen::Matrix2d* psi) {
@@ -154,6 +180,13 @@ PoseMap WnoaTrajectory::PoseAt(double t) const {
     }
   }
   return map;
+}
+
+std::vector<TrajectoryModel::PriorScale> WnoaTrajectory::PriorRowScales(
+    const std::vector<double*>& blocks, int num_rows) const {
+  if (blocks.size() != 2) return std::vector<PriorScale>(num_rows, PriorScale::kNone);
+  const PriorScale p = PriorScale::kPosition, h = PriorScale::kHeading;
+  return {p, p, h, p, p, h};
 }
 
 void WnoaTrajectory::AddPriorCosts(ceres::Problem* problem, int begin,

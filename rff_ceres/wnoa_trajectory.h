@@ -76,8 +76,18 @@ class WnoaTrajectory : public TrajectoryModel {
   void AddPriorCosts(ceres::Problem* problem, int begin, int end) override;
   const MeanFunction& mean() const override;
   void set_mean(std::shared_ptr<const MeanFunction> mean) override;
+  // The motion prior's rows follow the state (position, position, heading,
+  // ...); the initial-state prior has a fixed scale.
+  std::vector<PriorScale> PriorRowScales(const std::vector<double*>& blocks,
+                                         int num_rows) const override;
 
   const std::vector<double>& state_times() const;
+
+  // Sets every state to follow `poses` (sorted by time, at least one):
+  // positions from their linear interpolation minus the mean, velocities by
+  // central differences. The Markov states make this exact where a
+  // least-squares fit would need a solve of the whole trajectory.
+  void SetStatesFromPoses(const std::vector<TimedPose>& poses);
 
   // The per-coordinate 2x2 interpolation matrices at `elapsed` = tau - t_i
   // in an interval of length `dt` = t_{i+1} - t_i > 0, in closed form

@@ -299,6 +299,7 @@ TEST(SlamSolverTest, RobustOdometryLossRejectsSlippingRecords) {
   SlamOptions options = PaperSolverOptions();
   options.prior_mean = "localization";
   options.outer_rounds = 2;
+  options.problem.odometry_loss = {"none", 1.0};
   SlamResult plain;
   ASSERT_TRUE(RunSlam(dataset, options, &plain, &error)) << error;
   options.problem.odometry_loss = {"cauchy", 2.0};

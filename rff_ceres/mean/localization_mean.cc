@@ -354,11 +354,7 @@ std::shared_ptr<const MeanFunction> BuildLocalizationMean(
     *error = prefix + "the dataset has no PRIOR_POSE record";
     return nullptr;
   }
-  const PosePrior& first =
-      *std::min_element(dataset.pose_priors.begin(), dataset.pose_priors.end(),
-                        [](const PosePrior& a, const PosePrior& b) {
-                          return a.pose.t < b.pose.t;
-                        });
+  const PosePrior& first = EarliestPosePrior(dataset);
 
   // Dead reckoning, when fused: the fixes then only correct its drift.
   std::unique_ptr<PiecewiseLinearMean> dead_reckoning;

@@ -9,21 +9,13 @@
 namespace rff {
 
 std::vector<std::string> PriorMeanNames() {
-  return {"auto", "odometry", "localization", "spline", "constant"};
+  return {"auto", "odometry", "wnoa", "localization", "spline", "constant"};
 }
 
 namespace {
 
 // The paper's smoothing parameter of the spline prior (III-B.2).
 constexpr double kPaperSplineSmoothing = 0.98;
-
-const PosePrior& EarliestPrior(const Dataset& dataset) {
-  return *std::min_element(dataset.pose_priors.begin(),
-                           dataset.pose_priors.end(),
-                           [](const PosePrior& a, const PosePrior& b) {
-                             return a.pose.t < b.pose.t;
-                           });
-}
 
 std::string NameList() {
   std::string list;
@@ -59,6 +51,10 @@ std::shared_ptr<const MeanFunction> BuildPriorMean(
     *error = "prior mean '" + name + "': the dataset has no PRIOR_POSE record";
     return nullptr;
   }
+  if (name == "wnoa") {
+    *error = "prior mean 'wnoa' is a solve of the WNOA prior: RunSlam builds it";
+    return nullptr;
+  }
   // From the inputs only: observations in the mean would count twice.
   if (name == "auto") {
     return BuildPriorMean(dataset.odometry.empty() ? "constant" : "odometry",
@@ -66,7 +62,7 @@ std::shared_ptr<const MeanFunction> BuildPriorMean(
   }
   if (name == "constant") {
     return std::make_shared<PiecewiseLinearMean>(
-        std::vector<TimedPose>{EarliestPrior(dataset).pose});
+        std::vector<TimedPose>{EarliestPosePrior(dataset).pose});
   }
   if (name == "odometry") {
     DeadReckoningResult result;

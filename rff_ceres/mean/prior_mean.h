@@ -24,6 +24,9 @@ std::vector<std::string> PriorMeanNames();
 // "spline": a smoothing spline (p = 0.98) through the "localization" mean at
 //   the observation times, the first round of the paper's III-B.2.
 // "constant": the earliest PRIOR_POSE at every time.
+// "wnoa": the posterior mean of the WNOA prior given the whole dataset, for
+//   the RFF prior; a solve, so RunSlam builds it (slam_solver.h) and this
+//   function fails on it.
 // "auto": odometry if the dataset has ODOM records, else constant: the mean
 //   comes from the inputs only (the observations enter as residuals; a
 //   localisation of them is the solver's initial value, not its mean).

@@ -153,7 +153,7 @@ TEST(PriorMeanTest, RegistryRejectsUnknownNames) {
   std::string error;
   EXPECT_EQ(BuildPriorMean("magic", dataset, &error), nullptr);
   EXPECT_EQ(error,
-            "unknown prior mean 'magic' (expected auto, odometry, "
+            "unknown prior mean 'magic' (expected auto, odometry, wnoa, "
             "localization, spline or constant)");
   EXPECT_THAT(PriorMeanNames(), ::testing::Contains("localization"));
   // Odometry is asked for but the dataset has none.

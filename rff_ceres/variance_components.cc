@@ -1,0 +1,104 @@
+#include "rff_ceres/variance_components.h"
+
+#include <random>
+#include <vector>
+
+#include "Eigen/SparseCholesky"
+#include "ceres/crs_matrix.h"
+#include "glog/logging.h"
+
+namespace rff {
+
+const char* VarianceGroupName(VarianceGroup group) {
+  switch (group) {
+    case VarianceGroup::kFixed:
+      return "fixed";
+    case VarianceGroup::kRange:
+      return "range";
+    case VarianceGroup::kBearing:
+      return "bearing";
+    case VarianceGroup::kOdometry:
+      return "odometry";
+    case VarianceGroup::kPriorPosition:
+      return "trajectory position";
+    case VarianceGroup::kPriorHeading:
+      return "trajectory heading";
+  }
+  return "unknown";
+}
+
+bool Linearize(ceres::Problem* problem,
+               const std::vector<ceres::ResidualBlockId>& blocks,
+               double* cost, Eigen::VectorXd* residuals,
+               Eigen::SparseMatrix<double, Eigen::RowMajor>* jacobian,
+               std::string* error) {
+  ceres::Problem::EvaluateOptions options;
+  options.residual_blocks = blocks;
+  std::vector<double> values;
+  ceres::CRSMatrix crs;
+  if (!problem->Evaluate(options, cost, &values, nullptr, &crs)) {
+    *error = "the problem could not be evaluated";
+    return false;
+  }
+  *residuals = Eigen::Map<const Eigen::VectorXd>(
+      values.data(), static_cast<Eigen::Index>(values.size()));
+  *jacobian = Eigen::Map<const Eigen::SparseMatrix<double, Eigen::RowMajor>>(
+      crs.num_rows, crs.num_cols, static_cast<int>(crs.values.size()),
+      crs.rows.data(), crs.cols.data(), crs.values.data());
+  return true;
+}
+
+bool EstimateVarianceComponents(SlamProblem* problem,
+                                const VarianceComponentOptions& options,
+                                VarianceComponents* components,
+                                std::string* error) {
+  *components = VarianceComponents();
+  std::vector<ceres::ResidualBlockId> ids;
+  problem->problem()->GetResidualBlocks(&ids);
+  double cost = 0.0;
+  Eigen::VectorXd residuals;
+  Eigen::SparseMatrix<double, Eigen::RowMajor> jacobian;
+  if (!Linearize(problem->problem(), ids, &cost, &residuals, &jacobian,
+                 error)) {
+    return false;
+  }
+  const std::vector<VarianceGroup> groups = problem->RowGroups(ids);
+  CHECK_EQ(static_cast<Eigen::Index>(groups.size()), residuals.size());
+  const Eigen::SparseMatrix<double> hessian =
+      Eigen::SparseMatrix<double>(jacobian.transpose()) * jacobian;
+  const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(hessian);
+  if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > 0.0)) {
+    *error = "the Gauss-Newton Hessian is not positive definite";
+    return false;
+  }
+
+  std::array<double, kNumVarianceGroups> traces{};
+  std::mt19937 engine(options.seed);
+  Eigen::VectorXd z(hessian.cols());
+  for (int probe = 0; probe < options.probes; ++probe) {
+    for (Eigen::Index i = 0; i < z.size(); ++i) {
+      z[i] = (engine() & 1u) ? 1.0 : -1.0;
+    }
+    const Eigen::VectorXd jz = jacobian * z;
+    const Eigen::VectorXd ju = jacobian * ldlt.solve(z);
+    for (Eigen::Index r = 0; r < jz.size(); ++r) {
+      traces[static_cast<int>(groups[r])] += jz[r] * ju[r];
+    }
+  }
+  for (Eigen::Index r = 0; r < residuals.size(); ++r) {
+    VarianceComponent& c = (*components)[static_cast<int>(groups[r])];
+    ++c.rows;
+    c.sum_squares += residuals[r] * residuals[r];
+  }
+  for (int g = 0; g < kNumVarianceGroups; ++g) {
+    VarianceComponent& c = (*components)[g];
+    c.redundancy = c.rows - traces[g] / options.probes;
+    if (g != static_cast<int>(VarianceGroup::kFixed) &&
+        c.redundancy >= options.min_redundancy) {
+      c.factor = c.sum_squares / c.redundancy;
+    }
+  }
+  return true;
+}
+
+}  // namespace rff

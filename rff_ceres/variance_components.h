@@ -1,0 +1,66 @@
+// Variance-component estimation at a MAP: by how much the variance of each
+// group of residual rows (a kind of data, a scale of the trajectory prior)
+// should change for the residuals to be as large as the model says. With
+// whitened rows r_g of group g, J_g their rows of the Jacobian and
+// H = J^T J the Gauss-Newton Hessian of the whole problem,
+//
+//   s_g = r_g^T r_g / (n_g - tr(H^-1 J_g^T J_g)),
+//
+// the denominator being the group's redundancy: its rows less the share of
+// the parameters they determine (Foerstner 1979; Koch 1999, 3.6; for the
+// prior's scale it is MacKay's 1992 fixed point gamma). Iterating solve and
+// rescale maximises the Laplace evidence over the scales. The traces come
+// from Hutchinson's estimator tr(A) = E[z^T A z] with seeded Rademacher
+// probes and one sparse solve each.
+#ifndef RFF_CERES_VARIANCE_COMPONENTS_H_
+#define RFF_CERES_VARIANCE_COMPONENTS_H_
+
+#include <array>
+#include <string>
+#include <vector>
+
+#include "Eigen/SparseCore"
+#include "ceres/problem.h"
+#include "rff_ceres/slam_problem.h"
+
+namespace rff {
+
+struct VarianceComponent {
+  int rows = 0;
+  double sum_squares = 0.0;  // r_g^T r_g (robust-weighted).
+  double redundancy = 0.0;   // n_g - tr(H^-1 J_g^T J_g).
+  // s_g; 1 where the group has no rows or too little redundancy to tell.
+  double factor = 1.0;
+};
+
+struct VarianceComponentOptions {
+  int probes = 24;
+  unsigned seed = 1;
+  // Below this redundancy a group's factor is left at 1: the data say
+  // little about it.
+  double min_redundancy = 10.0;
+};
+
+using VarianceComponents = std::array<VarianceComponent, kNumVarianceGroups>;
+
+// The factors at the problem's current values (call at a MAP). Fails when
+// the problem cannot be evaluated or its Hessian is not positive definite.
+bool EstimateVarianceComponents(SlamProblem* problem,
+                                const VarianceComponentOptions& options,
+                                VarianceComponents* components,
+                                std::string* error);
+
+// The residuals and Jacobian of `blocks` (in that order, through their
+// robust losses) at the problem's current values.
+bool Linearize(ceres::Problem* problem,
+               const std::vector<ceres::ResidualBlockId>& blocks, double* cost,
+               Eigen::VectorXd* residuals,
+               Eigen::SparseMatrix<double, Eigen::RowMajor>* jacobian,
+               std::string* error);
+
+// "range", "bearing", "odometry", "trajectory position", ... for reports.
+const char* VarianceGroupName(VarianceGroup group);
+
+}  // namespace rff
+
+#endif  // RFF_CERES_VARIANCE_COMPONENTS_H_
