@@ -6,9 +6,14 @@
 namespace rff {
 
 Eigen::Vector3d TrajectoryModel::Pose(double t) const {
-  std::vector<const double*> blocks(num_blocks());
-  for (int i = 0; i < num_blocks(); ++i) blocks[i] = block(i);
-  return EvaluatePose(PoseAt(t), blocks.data());
+  // Only the blocks the map touches: a pose costs its terms, not the run.
+  const PoseMap map = PoseAt(t);
+  Eigen::Vector3d pose = map.mean;
+  for (const PoseTerm& term : map.terms) {
+    pose[term.coordinate] += term.phi->dot(Eigen::Map<const Eigen::VectorXd>(
+        block(term.block), term.phi->size()));
+  }
+  return pose;
 }
 
 std::vector<double> ModelBlocks(const TrajectoryModel& model) {
