@@ -81,6 +81,7 @@ class FeatureTrajectory : public TrajectoryModel {
     return weights_.data() + offsets_[block];
   }
   int num_segments() const { return static_cast<int>(segments_.size()); }
+  bool HasDenseReducedSystem() const override { return true; }
   PoseMap PoseAt(double t) const override;
   using TrajectoryModel::AddPriorCosts;
   void AddPriorCosts(ceres::Problem* problem, int begin, int end) override;

@@ -38,9 +38,9 @@ PoseMap MeanRotationTrajectory::PoseAt(double t) const {
   const double g[3] = {-arm.y(), arm.x(), 1.0};
   for (int c = 0; c < 3; ++c) {
     if (g[c] != 0.0) {
-      map.terms.push_back(
-          {0, c, std::make_shared<const Eigen::VectorXd>(
-                     Eigen::VectorXd::Constant(1, g[c]))});
+      map.terms.push_back({0, c,
+                           std::make_shared<const Eigen::VectorXd>(
+                               Eigen::VectorXd::Constant(1, g[c]))});
     }
   }
   return map;
@@ -57,7 +57,8 @@ void MeanRotationTrajectory::AddPriorCosts(ceres::Problem* problem, int begin,
   inner_->AddPriorCosts(problem, std::max(begin - 1, 0), std::max(end - 1, 0));
 }
 
-void MeanRotationTrajectory::set_mean(std::shared_ptr<const MeanFunction> mean) {
+void MeanRotationTrajectory::set_mean(
+    std::shared_ptr<const MeanFunction> mean) {
   mean_ = mean;
   inner_->set_mean(std::move(mean));
 }

@@ -49,6 +49,9 @@ class MeanRotationTrajectory : public TrajectoryModel {
   double* mutable_block(int block) override {
     return block == 0 ? &delta_ : inner_->mutable_block(block - 1);
   }
+  bool HasDenseReducedSystem() const override {
+    return inner_->HasDenseReducedSystem();
+  }
   bool IsSharedBlock(int block) const override {
     return block == 0 || inner_->IsSharedBlock(block - 1);
   }

@@ -43,7 +43,8 @@ ceres::LinearSolverType AutoLinearSolverType(const TrajectoryModel& model) {
   for (int b = 0; b < model.num_blocks(); ++b) {
     trajectory_parameters += model.block_size(b);
   }
-  return trajectory_parameters <= kMaxDenseReducedSystem
+  return model.HasDenseReducedSystem() &&
+                 trajectory_parameters <= kMaxDenseReducedSystem
              ? ceres::DENSE_SCHUR
              : ceres::SPARSE_NORMAL_CHOLESKY;
 }

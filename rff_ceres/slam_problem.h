@@ -91,9 +91,10 @@ struct ProblemOptions {
 };
 
 // The linear solver of "auto": DENSE_SCHUR when the reduced system (every
-// trajectory parameter after the landmarks are eliminated) has at most
-// kMaxDenseReducedSystem unknowns, else SPARSE_NORMAL_CHOLESKY, whose
-// fill-reducing ordering handles landmarks seen from the whole run.
+// trajectory parameter after the landmarks are eliminated) is dense by the
+// model's structure and has at most kMaxDenseReducedSystem unknowns, else
+// SPARSE_NORMAL_CHOLESKY, whose fill-reducing ordering handles landmarks
+// seen from the whole run and banded WNOA states.
 inline constexpr int kMaxDenseReducedSystem = 2000;
 ceres::LinearSolverType AutoLinearSolverType(const TrajectoryModel& model);
 

@@ -186,11 +186,16 @@ void ChooseLinearSolver(const SolverOptions& solver,
   const bool dense = options->linear_solver_type == ceres::DENSE_SCHUR;
   result->linear_solver =
       ceres::LinearSolverTypeToString(options->linear_solver_type);
+  const std::string count =
+      std::to_string(trajectory_parameters) + " trajectory parameters";
   result->linear_solver_reason =
-      std::to_string(trajectory_parameters) + " trajectory parameters " +
-      (dense ? "<= " : "> ") + std::to_string(kMaxDenseReducedSystem) +
-      (dense ? ": the reduced system is small and dense"
-             : ": sparse factorisation of the whole system");
+      dense ? count + " <= " + std::to_string(kMaxDenseReducedSystem) +
+                  ": the reduced system is small and dense"
+      : model.HasDenseReducedSystem()
+          ? count + " > " + std::to_string(kMaxDenseReducedSystem) +
+                ": sparse factorisation of the whole system"
+          : count + " in banded states: sparse factorisation of the whole "
+                    "system";
 }
 
 // Schur solvers eliminate the landmarks first. The others get no ordering:
@@ -477,6 +482,10 @@ bool SolveWnoa(const Dataset& dataset, const SlamOptions& options,
   wnoa.prior_mean = "auto";
   wnoa.outer_rounds = 0;
   wnoa.compute_covariance = false;
+  // The user's linear solver is for the RFF solve; banded states want their
+  // own (AutoLinearSolverType).
+  wnoa.solver.linear_solver = "auto";
+  wnoa.solver.preconditioner = "auto";
   return RunSlam(dataset, wnoa, solve, error);
 }
 
@@ -648,14 +657,16 @@ bool RunSlam(const Dataset& dataset, const SlamOptions& options,
     *error = "prior mean 'wnoa' is for the rff prior";
     return false;
   }
-  // The RFF prior starts from a WNOA solve where nothing else is asked: as
-  // its mean with a "wnoa" mean, else as its initial value.
+  // The RFF prior starts from a WNOA solve: as its mean with a "wnoa" mean;
+  // as its initial value without odometry, where the localisation pilot
+  // has no motion model to bridge gaps between fixes.
   SlamOptions warm = options;
   const auto mean_start = std::chrono::steady_clock::now();
   std::shared_ptr<const MeanFunction> mean;
   if (options.prior == "rff" && incremental.every == 0 &&
       (result->prior_mean == "wnoa" ||
-       (options.initial_trajectory == "auto" && options.initial_poses.empty()))) {
+       (dataset.odometry.empty() && options.initial_trajectory == "auto" &&
+        options.initial_poses.empty()))) {
     SlamResult wnoa;
     if (!SolveWnoa(dataset, options, &wnoa, error)) return false;
     if (result->prior_mean == "wnoa") {

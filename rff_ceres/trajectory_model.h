@@ -53,6 +53,11 @@ class TrajectoryModel {
   virtual std::vector<PriorScale> PriorRowScales(
       const std::vector<double*>& blocks, int num_rows) const = 0;
 
+  // Whether the reduced system (landmarks eliminated) is dense for this
+  // model's structure: global feature maps are, Markov states (banded)
+  // are not, whatever their number.
+  virtual bool HasDenseReducedSystem() const { return false; }
+
   // Whether every pose depends on the block (not a block local in time):
   // the problem orders such blocks in a group of their own, so that their
   // place in the solve does not depend on their address.

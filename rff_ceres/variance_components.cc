@@ -28,8 +28,8 @@ const char* VarianceGroupName(VarianceGroup group) {
 }
 
 bool Linearize(ceres::Problem* problem,
-               const std::vector<ceres::ResidualBlockId>& blocks,
-               double* cost, Eigen::VectorXd* residuals,
+               const std::vector<ceres::ResidualBlockId>& blocks, double* cost,
+               Eigen::VectorXd* residuals,
                Eigen::SparseMatrix<double, Eigen::RowMajor>* jacobian,
                std::string* error) {
   ceres::Problem::EvaluateOptions options;
