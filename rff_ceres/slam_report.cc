@@ -28,8 +28,9 @@ void PrintSlamSummary(const SlamOptions& options, const SlamResult& result,
   const FeatureTrajectoryOptions& t = result.trajectory_options;
   if (options.prior == "wnoa") {
     *out << "  model        WNOA (LTV-SDE) prior, Q_c = "
-         << result.wnoa_options.position_qc << " (x, y), " << result.wnoa_options.heading_qc
-         << " (theta), " << result.prior_mean << " mean\n";
+         << result.wnoa_options.position_qc << " (x, y), "
+         << result.wnoa_options.heading_qc << " (theta), " << result.prior_mean
+         << " mean\n";
   } else {
     *out << "  model        " << t.family << " features, "
          << t.position_kernel.name << " kernel, D = " << t.num_position_features
@@ -48,13 +49,18 @@ void PrintSlamSummary(const SlamOptions& options, const SlamResult& result,
            << t.segment_overlap << " s";
     }
     *out << "\n";
-    if (result.learned) {
+    if (result.learning.evaluations > 0) {
       *out << "  learned      by the Laplace evidence on the first "
            << result.learning.window_end - result.trajectory.front().t
            << " s: log evidence " << result.learning.log_evidence << ", "
            << result.learning.evaluations << " solves, "
            << result.learning.seconds << " s\n";
     }
+  }
+  if (result.learning_rounds > 0) {
+    *out << "  scales       " << (options.prior == "wnoa" ? "Q_c" : "variances")
+         << " learned by variance components, " << result.learning_rounds
+         << " rounds\n";
   }
   *out << "  problem      " << s.num_residual_blocks << " residual blocks, "
        << s.num_parameters << " parameters\n"
@@ -125,19 +131,24 @@ bool WriteSummaryJson(const SlamOptions& options, const SlamResult& result,
       << "  \"log_evidence\": " << FormatNumber(result.learning.log_evidence)
       << ",\n"
       << "  \"learning_solves\": " << result.learning.evaluations << ",\n"
+      << "  \"learning_rounds\": " << result.learning_rounds << ",\n"
       << "  \"learning_seconds\": " << FormatNumber(result.learning.seconds)
       << ",\n"
       << "  \"features\": " << JsonString(t.family) << ",\n"
       << "  \"num_features\": " << t.num_position_features << ",\n"
       << "  \"num_heading_features\": " << t.num_heading_features << ",\n"
       << "  \"seed\": " << t.seed << ",\n"
-      << "  \"wnoa_position_qc\": " << FormatNumber(result.wnoa_options.position_qc)
-      << ",\n"
-      << "  \"wnoa_heading_qc\": " << FormatNumber(result.wnoa_options.heading_qc)
-      << ",\n"
+      << "  \"wnoa_position_qc\": "
+      << FormatNumber(result.wnoa_options.position_qc) << ",\n"
+      << "  \"wnoa_heading_qc\": "
+      << FormatNumber(result.wnoa_options.heading_qc) << ",\n"
       << "  \"loss\": " << JsonString(options.problem.loss.name) << ",\n"
+      << "  \"loss_scale\": " << FormatNumber(options.problem.loss.scale)
+      << ",\n"
       << "  \"odometry_loss\": "
       << JsonString(options.problem.odometry_loss.name) << ",\n"
+      << "  \"odometry_loss_scale\": "
+      << FormatNumber(options.problem.odometry_loss.scale) << ",\n"
       << "  \"linear_solver\": " << JsonString(result.linear_solver) << ",\n"
       << "  \"linear_solver_reason\": "
       << JsonString(result.linear_solver_reason) << ",\n"

@@ -11,9 +11,9 @@
 #include "rff_ceres/initialization.h"
 #include "rff_ceres/io/text_parser.h"
 #include "rff_ceres/landmark_init.h"
-#include "rff_ceres/mean_rotation.h"
 #include "rff_ceres/mean/prior_mean.h"
 #include "rff_ceres/mean/spline_mean.h"
+#include "rff_ceres/mean_rotation.h"
 #include "rff_ceres/posterior_covariance.h"
 #include "rff_ceres/variance_components.h"
 
@@ -194,8 +194,9 @@ void ChooseLinearSolver(const SolverOptions& solver,
       : model.HasDenseReducedSystem()
           ? count + " > " + std::to_string(kMaxDenseReducedSystem) +
                 ": sparse factorisation of the whole system"
-          : count + " in banded states: sparse factorisation of the whole "
-                    "system";
+          : count +
+                " in banded states: sparse factorisation of the whole "
+                "system";
 }
 
 // Schur solvers eliminate the landmarks first. The others get no ordering:
@@ -275,7 +276,8 @@ bool CollectTrajectory(const Dataset& dataset, const TrajectoryModel& model,
 // (kMaxRotationLinearization), applies it exactly and returns true: the
 // problem is then solved again about the turned mean.
 constexpr double kMaxRotationLinearization = 0.01;  // m
-bool FoldMeanRotation(TrajectoryModel* model, const std::vector<double>& times) {
+bool FoldMeanRotation(TrajectoryModel* model,
+                      const std::vector<double>& times) {
   auto* rotation = dynamic_cast<MeanRotationTrajectory*>(model);
   if (rotation == nullptr ||
       rotation->LinearizationError(times) <= kMaxRotationLinearization) {
@@ -498,8 +500,8 @@ SolveFacts SolveFactsOf(const SlamOptions& options, const SlamResult& result) {
   facts.range_calibrated = options.problem.range_calibration.estimate;
   facts.range_calibration = result.range_calibration;
   const double scale = result.range_calibration[0];
-  const double offset_bound = kMaxOffsetSigmas *
-                              options.problem.range_calibration.offset_sigma;
+  const double offset_bound =
+      kMaxOffsetSigmas * options.problem.range_calibration.offset_sigma;
   constexpr double kAtBound = 1e-6;
   facts.range_calibration_at_bound =
       scale < kMinRangeScale + kAtBound || scale > kMaxRangeScale - kAtBound ||
@@ -533,50 +535,67 @@ bool InitializeBlocks(const Dataset& start, const SlamOptions& options,
   return true;
 }
 
-// Learns the WNOA Q_c of x, y and theta where the prior is the only model
-// of the motion (no odometry): after the first MAP, each round rescales
-// Q_c by its variance-component factor (variance_components.h, MacKay's
-// fixed point of the Laplace evidence) and solves again from the current
-// estimate, until every factor is within kScaleTolerance of one.
+// Learns the scales of the trajectory prior (WNOA Q_c, RFF kernel
+// variances) of x, y and theta: after the first MAP, each round rescales
+// them by their variance-component factors (variance_components.h,
+// MacKay's fixed point of the Laplace evidence) and solves again from the
+// current estimate, until every factor is within kScaleTolerance of one.
 constexpr int kMaxScaleRounds = 6;
 constexpr double kScaleTolerance = 0.1;
 constexpr double kMaxScaleStep = 10.0;  // Per round, either way.
-bool LearnWnoaScales(const Dataset& dataset,
-                     std::shared_ptr<const MeanFunction> mean,
-                     const ceres::Solver::Options& ceres_options,
-                     double initial_extent, SlamOptions* settled,
-                     std::unique_ptr<TrajectoryModel>* model,
-                     std::map<LandmarkId, Eigen::Vector2d>* landmarks,
-                     std::unique_ptr<SlamProblem>* problem, SlamResult* result,
-                     std::string* error) {
+bool LearnPriorScales(const Dataset& dataset,
+                      std::shared_ptr<const MeanFunction> mean,
+                      const ceres::Solver::Options& ceres_options,
+                      double initial_extent, SlamOptions* settled,
+                      std::unique_ptr<TrajectoryModel>* model,
+                      std::map<LandmarkId, Eigen::Vector2d>* landmarks,
+                      std::unique_ptr<SlamProblem>* problem, SlamResult* result,
+                      std::string* error) {
+  const bool wnoa = settled->prior == "wnoa";
+  double* position_scale = wnoa ? &settled->wnoa.position_qc
+                                : &settled->trajectory.position_kernel.variance;
+  double* heading_scale = wnoa ? &settled->wnoa.heading_qc
+                               : &settled->trajectory.heading_kernel.variance;
   for (int round = 0; round < kMaxScaleRounds; ++round) {
     VarianceComponents components;
     if (!EstimateVarianceComponents(problem->get(), VarianceComponentOptions(),
                                     &components, error)) {
-      *error = "learning Q_c: " + *error;
+      *error = "learning the prior's scales: " + *error;
       return false;
     }
     double largest_step = 0.0;
-    auto rescale = [&](VarianceGroup group, double* qc) {
+    auto rescale = [&](VarianceGroup group, double* scale) {
       const double factor =
           std::clamp(components[static_cast<int>(group)].factor,
                      1.0 / kMaxScaleStep, kMaxScaleStep);
       largest_step = std::max(largest_step, std::abs(std::log(factor)));
-      *qc *= factor;
+      *scale *= factor;
     };
-    rescale(VarianceGroup::kPriorPosition, &settled->wnoa.position_qc);
-    rescale(VarianceGroup::kPriorHeading, &settled->wnoa.heading_qc);
-    // Q_c scales the prior only: the states stay where they are.
-    const std::vector<double> states = ModelBlocks(**model);
+    rescale(VarianceGroup::kPriorPosition, position_scale);
+    rescale(VarianceGroup::kPriorHeading, heading_scale);
+    VLOG(1)
+        << "prior scale round " << round << ": position factor "
+        << components[static_cast<int>(VarianceGroup::kPriorPosition)].factor
+        << ", heading factor "
+        << components[static_cast<int>(VarianceGroup::kPriorHeading)].factor;
+    result->learning_rounds = round + 1;
+    if (largest_step < std::log1p(kScaleTolerance)) break;
+    // Q_c scales the WNOA prior only: its states stay as they are. RFF
+    // features follow the variance (capacity): refit them to the estimate.
+    const std::vector<double> blocks = ModelBlocks(**model);
+    const std::vector<TimedPose> estimate = result->trajectory;
     *model = CreateTrajectoryModel(dataset, *settled, mean, error);
     if (!*model) return false;
-    SetModelBlocks(states, model->get());
+    if (wnoa) {
+      SetModelBlocks(blocks, model->get());
+    } else if (!FitModelToPoses(estimate, model->get(), error)) {
+      return false;
+    }
     if (!SolveBatch(dataset, *settled, ceres_options, model->get(), landmarks,
                     initial_extent, problem, result, error)) {
       return false;
     }
     result->learned = true;
-    if (largest_step < std::log1p(kScaleTolerance)) break;
   }
   return true;
 }
@@ -683,10 +702,9 @@ bool RunSlam(const Dataset& dataset, const SlamOptions& options,
                           error);
   }
   if (!mean) return false;
-  result->mean_seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() -
-                                    mean_start)
-          .count();
+  result->mean_seconds = std::chrono::duration<double>(
+                             std::chrono::steady_clock::now() - mean_start)
+                             .count();
   std::unique_ptr<TrajectoryModel> model =
       CreateTrajectoryModel(dataset, options, mean, error);
   if (!model) return false;
@@ -719,6 +737,19 @@ bool RunSlam(const Dataset& dataset, const SlamOptions& options,
   const bool search =
       options.learn_hyperparameters == "on" ||
       (options.learn_hyperparameters == "auto" && dataset.odometry.empty());
+  // With a "wnoa" mean the RFF weights are a correction to a solve of the
+  // same data: its variances start at what the capacity rule resolves and
+  // are learned from the data (LearnPriorScales).
+  const bool correction = options.prior == "rff" &&
+                          result->prior_mean == "wnoa" &&
+                          options.learn_hyperparameters != "off";
+  if (correction) {
+    FeatureTrajectoryOptions& t = settled.trajectory;
+    t.position_kernel.variance = std::pow(2.0 * t.capacity_position_sigma, 2);
+    t.heading_kernel.variance = std::pow(2.0 * t.capacity_heading_sigma, 2);
+    model = CreateTrajectoryModel(dataset, settled, mean, error);
+    if (!model) return false;
+  }
   if (options.prior == "rff" && options.learn_hyperparameters == "auto" &&
       !search && result->initial_trajectory == "localization") {
     // Drift of dead reckoning: its size from the pilot, its time scale given.
@@ -736,10 +767,6 @@ bool RunSlam(const Dataset& dataset, const SlamOptions& options,
     result->learned = true;
     model = CreateTrajectoryModel(dataset, settled, mean, error);
     if (!model || !FitModelToPoses(initial, model.get(), error)) return false;
-  }
-  if (const auto* features =
-          dynamic_cast<const FeatureTrajectory*>(InnerModel(model.get()))) {
-    result->trajectory_options = features->options();
   }
   double initial_extent = Extent(initial, landmarks);
   for (const LandmarkPrior& p : dataset.landmark_priors) {
@@ -766,13 +793,17 @@ bool RunSlam(const Dataset& dataset, const SlamOptions& options,
   } else if (!SolveBatch(dataset, settled, ceres_options, model.get(),
                          &landmarks, initial_extent, &problem, result, error)) {
     return false;
-  } else if (options.prior == "wnoa" && search &&
-             !LearnWnoaScales(dataset, mean, ceres_options, initial_extent,
-                              &settled, &model, &landmarks, &problem, result,
-                              error)) {
+  } else if (((options.prior == "wnoa" && search) || correction) &&
+             !LearnPriorScales(dataset, mean, ceres_options, initial_extent,
+                               &settled, &model, &landmarks, &problem, result,
+                               error)) {
     return false;
   }
   result->wnoa_options = settled.wnoa;
+  if (const auto* features =
+          dynamic_cast<const FeatureTrajectory*>(InnerModel(model.get()))) {
+    result->trajectory_options = features->options();
+  }
   if (!problem->CheckLandmarksDetermined(1e12, error)) return false;
   result->quality = AssessQuality(problem->WhitenedResidualsByKind(),
                                   SolveFactsOf(settled, *result));

@@ -121,6 +121,8 @@ struct SlamResult {
   WnoaOptions wnoa_options;
   bool learned = false;
   LearningReport learning;
+  // Rounds of variance-component rescaling of the prior's scales.
+  int learning_rounds = 0;
   // The linear solver used and why ("auto" settles on one per problem).
   std::string linear_solver;
   std::string linear_solver_reason;
