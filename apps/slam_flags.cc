@@ -8,8 +8,11 @@ DEFINE_string(prior, "rff",
               "method) or wnoa (LTV-SDE white-noise-on-acceleration states, "
               "the gpslam baseline).");
 DEFINE_string(prior_mean, "auto",
-              "Prior mean: auto (odometry if the dataset has ODOM, else "
-              "constant), odometry, localization, spline or constant.");
+              "Prior mean: auto, odometry, wnoa, localization, spline or "
+              "constant. auto: with ODOM records, for the RFF prior in batch "
+              "mode wnoa (the WNOA posterior mean, which RFF then corrects), "
+              "else odometry (dead reckoning, allowed to turn about its "
+              "start); without, constant.");
 DEFINE_string(initial_trajectory, "auto",
               "Initial value of the trajectory: auto (fit to a localisation "
               "against the landmark priors when one can be built, else the "
@@ -47,13 +50,14 @@ DEFINE_int32(num_features, 0,
              "0.005 rad.");
 DEFINE_int32(num_heading_features, 0, "Features of theta (0: --num_features).");
 DEFINE_string(learn_hyperparameters, "auto",
-              "RFF: learn the lengthscales and variances of x, y and theta "
-              "by the Laplace approximation of the marginal likelihood on the "
-              "first 300 s, starting from --lengthscale, --kernel_variance, "
-              "...: on, off, or auto (on for data without odometry; batch "
-              "mode only; off when any of those four is given, on the "
-              "command line or in a flagfile, as they are then the user's "
-              "choice).");
+              "Learn the prior's hyperparameters from the data: on, off or "
+              "auto. RFF: lengthscales and variances of x, y and theta by the "
+              "Laplace evidence (auto: without odometry), and the variances "
+              "of the correction to a wnoa mean; WNOA: Q_c by variance "
+              "components (auto: without odometry, where the prior is the "
+              "only motion model). Batch mode only. auto is off when a "
+              "kernel hyperparameter or Q_c is given (command line or "
+              "flagfile): they are then the user's choice.");
 DEFINE_uint64(seed, 1, "Seed of the random feature frequencies.");
 DEFINE_double(segment_length, 0.0,
               "Windowed weights: segment length in seconds (0: one global "
