@@ -132,6 +132,9 @@ bool WriteSummaryJson(const SlamOptions& options, const SlamResult& result,
       << ",\n"
       << "  \"learning_solves\": " << result.learning.evaluations << ",\n"
       << "  \"learning_rounds\": " << result.learning_rounds << ",\n"
+      << "  \"prior_scale_factors\": ["
+      << FormatNumber(result.prior_scale_factors[0]) << ", "
+      << FormatNumber(result.prior_scale_factors[1]) << "],\n"
       << "  \"learning_seconds\": " << FormatNumber(result.learning.seconds)
       << ",\n"
       << "  \"features\": " << JsonString(t.family) << ",\n"

@@ -579,6 +579,9 @@ bool LearnPriorScales(const Dataset& dataset,
         << ", heading factor "
         << components[static_cast<int>(VarianceGroup::kPriorHeading)].factor;
     result->learning_rounds = round + 1;
+    result->prior_scale_factors
+        << components[static_cast<int>(VarianceGroup::kPriorPosition)].factor,
+        components[static_cast<int>(VarianceGroup::kPriorHeading)].factor;
     if (largest_step < std::log1p(kScaleTolerance)) break;
     // Q_c scales the WNOA prior only: its states stay as they are. RFF
     // features follow the variance (capacity): refit them to the estimate.

@@ -121,8 +121,10 @@ struct SlamResult {
   WnoaOptions wnoa_options;
   bool learned = false;
   LearningReport learning;
-  // Rounds of variance-component rescaling of the prior's scales.
+  // Rounds of variance-component rescaling of the prior's scales, and the
+  // last round's factors (position, heading): about 1 at the fixed point.
   int learning_rounds = 0;
+  Eigen::Vector2d prior_scale_factors = Eigen::Vector2d::Ones();
   // The linear solver used and why ("auto" settles on one per problem).
   std::string linear_solver;
   std::string linear_solver_reason;
