@@ -52,7 +52,8 @@ DEFINE_int32(num_heading_features, 0, "Features of theta (0: --num_features).");
 DEFINE_string(learn_hyperparameters, "auto",
               "Learn the prior's hyperparameters from the data: on, off or "
               "auto. RFF: lengthscales and variances of x, y and theta by the "
-              "Laplace evidence (auto: without odometry), and the variances "
+              "evidence of the exact kernel with the observations linearised "
+              "about a WNOA solve (auto: without odometry), and the variances "
               "of the correction to a wnoa mean; WNOA: Q_c by variance "
               "components (auto: without odometry, where the prior is the "
               "only motion model). Batch mode only. auto is off when a "

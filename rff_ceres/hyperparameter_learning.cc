@@ -8,20 +8,14 @@
 #include <limits>
 #include <set>
 
-#include "Eigen/Cholesky"
-#include "Eigen/SparseCholesky"
-#include "Eigen/SparseCore"
-#include "ceres/crs_matrix.h"
-#include "ceres/solver.h"
 #include "glog/logging.h"
-#include "rff_ceres/initialization.h"
+#include "rff_ceres/kernels/kernel.h"
+#include "rff_ceres/pose_evidence.h"
 #include "rff_ceres/se2.h"
 
 namespace rff {
 namespace {
 
-// Largest Hessian factorised densely for the evidence.
-constexpr int kMaxDenseEvidence = 4000;
 // Below this spread (units^2) the initial trajectory is the mean itself.
 constexpr double kMinSpread = 1e-4;
 
@@ -118,41 +112,6 @@ void MatchVariancesToSpread(const MeanFunction& mean,
   }
 }
 
-bool LaplaceLogEvidence(ceres::Problem* problem, double* log_evidence,
-                        std::string* error) {
-  double cost = 0.0;
-  ceres::CRSMatrix crs;
-  if (!problem->Evaluate(ceres::Problem::EvaluateOptions(), &cost, nullptr,
-                         nullptr, &crs)) {
-    *error = "the problem could not be evaluated";
-    return false;
-  }
-  const Eigen::Map<const Eigen::SparseMatrix<double, Eigen::RowMajor>> jacobian(
-      crs.num_rows, crs.num_cols, static_cast<int>(crs.values.size()),
-      crs.rows.data(), crs.cols.data(), crs.values.data());
-  const Eigen::SparseMatrix<double> hessian =
-      Eigen::SparseMatrix<double>(jacobian.transpose()) * jacobian;
-  // Feature blocks are dense: a dense factorisation is faster up to a few
-  // thousand unknowns.
-  Eigen::VectorXd pivots;
-  if (hessian.rows() <= kMaxDenseEvidence) {
-    const Eigen::MatrixXd dense = hessian;
-    const Eigen::LLT<Eigen::MatrixXd> llt(dense);
-    if (llt.info() == Eigen::Success) {
-      pivots = llt.matrixLLT().diagonal().array().square();
-    }
-  } else {
-    const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(hessian);
-    if (ldlt.info() == Eigen::Success) pivots = ldlt.vectorD();
-  }
-  if (pivots.size() == 0 || !(pivots.minCoeff() > 0.0)) {
-    *error = "the Gauss-Newton Hessian is not positive definite";
-    return false;
-  }
-  *log_evidence = -cost - 0.5 * pivots.array().log().sum();
-  return std::isfinite(*log_evidence);
-}
-
 bool LearnHyperparameters(
     const Dataset& dataset, std::shared_ptr<const MeanFunction> mean,
     const std::vector<TimedPose>& initial,
@@ -168,63 +127,33 @@ bool LearnHyperparameters(
   }
   const double begin = initial.front().t;
   const double end = std::min(initial.back().t, begin + options.window);
-  report->window_end = end;
   const Dataset window = Window(dataset, end);
   std::vector<TimedPose> window_initial;
   for (const TimedPose& p : initial) {
     if (p.t <= end) window_initial.push_back(p);
   }
-  std::set<LandmarkId> used;
-  for (const LandmarkPrior& p : window.landmark_priors) used.insert(p.id);
-  for (const Observation& o : window.observations) used.insert(o.id);
-  std::map<LandmarkId, Eigen::Vector2d> window_landmarks;
-  for (const auto& [id, position] : landmarks) {
-    if (used.count(id)) window_landmarks[id] = position;
+  PoseLikelihood likelihood;
+  if (!LinearizeInPoses(window, initial, landmarks, problem_options, *mean,
+                        options.max_times, &likelihood, error)) {
+    return false;
   }
+  report->window_end = std::min(end, likelihood.times.back());
 
   FeatureTrajectoryOptions start_values = *trajectory;
   MatchVariancesToSpread(*mean, window_initial, &start_values);
-
-  ceres::Solver::Options solver;
-  solver.max_num_iterations = options.max_solver_iterations;
-  solver.logging_type = ceres::SILENT;
-  // Each candidate starts from the MAP of the best one so far, which is
-  // close to its own: a few iterations reach it.
-  std::vector<TimedPose> best_trajectory = window_initial;
-  std::vector<TimedPose> candidate_trajectory;
-  // The evidence of one candidate; -inf when its solve or Hessian fails.
+  // The evidence of one candidate; -inf where a kernel cannot be built.
   auto evidence = [&](const LogParameters& p) {
     ++report->evaluations;
     FeatureTrajectoryOptions candidate = *trajectory;
     FromLog(p, &candidate);
-    candidate.capacity_position_sigma *= options.capacity_relaxation;
-    candidate.capacity_heading_sigma *= options.capacity_relaxation;
     std::string why;
-    std::unique_ptr<FeatureTrajectory> model =
-        FeatureTrajectory::Create(candidate, mean, begin, end, &why);
-    double value = -std::numeric_limits<double>::infinity();
-    if (!model || !FitModelToPoses(best_trajectory, model.get(), &why)) {
-      return value;
-    }
-    SlamProblem problem(model.get(), problem_options);
-    if (!problem.Build(window, window_landmarks, &why)) return value;
-    solver.linear_solver_type = AutoLinearSolverType(*model);
-    solver.linear_solver_ordering = problem.Ordering();
-    if (solver.linear_solver_type != ceres::DENSE_SCHUR) {
-      solver.linear_solver_ordering.reset();
-    }
-    ceres::Solver::Summary summary;
-    ceres::Solve(solver, problem.problem(), &summary);
-    if (summary.termination_type == ceres::FAILURE ||
-        !LaplaceLogEvidence(problem.problem(), &value, &why)) {
-      return -std::numeric_limits<double>::infinity();
-    }
-    candidate_trajectory.clear();
-    for (const TimedPose& q : window_initial) {
-      const Eigen::Vector3d pose = model->Pose(q.t);
-      candidate_trajectory.push_back({q.t, pose.x(), pose.y(), pose.z()});
-    }
-    VLOG(1) << "evidence at lengthscale " << std::exp(p[0]) << ", variance "
+    const std::unique_ptr<Kernel> position =
+        CreateKernel(candidate.position_kernel, &why);
+    const std::unique_ptr<Kernel> heading =
+        CreateKernel(candidate.heading_kernel, &why);
+    if (!position || !heading) return -std::numeric_limits<double>::infinity();
+    const double value = PoseLogEvidence(likelihood, *position, *heading);
+    VLOG(2) << "evidence at lengthscale " << std::exp(p[0]) << ", variance "
             << std::exp(p[1]) << ", heading lengthscale " << std::exp(p[2])
             << ", variance " << std::exp(p[3]) << ": " << value;
     return value;
@@ -244,14 +173,12 @@ bool LearnHyperparameters(
     *error = "the evidence cannot be evaluated at the initial hyperparameters";
     return false;
   }
-  best_trajectory = candidate_trajectory;
-  // The evidence at `p`, keeping the best point and its MAP.
+  // The evidence at `p`, keeping the best point.
   auto visit = [&](const LogParameters& p) {
     const double value = evidence(p);
     if (value > best_value) {
       best = p;
       best_value = value;
-      best_trajectory = candidate_trajectory;
     }
     return value;
   };
@@ -259,7 +186,9 @@ bool LearnHyperparameters(
   // (maximised at every lengthscale): the evidence of a Matern kernel is
   // nearly flat along variance / lengthscale^(2 nu) = const, a ridge that a
   // search of one coordinate at a time cannot follow.
-  for (int sweep = 0; sweep < options.sweeps; ++sweep) {
+  double step = options.step;
+  for (int sweep = 0; sweep < options.sweeps;
+       ++sweep, step /= options.step_reduction) {
     for (const int kernel : {0, 2}) {
       auto profile = [&](double log_lengthscale) {
         LogParameters p = best;
@@ -271,16 +200,24 @@ bool LearnHyperparameters(
               q[kernel + 1] = log_variance;
               return visit(q);
             },
-            p[kernel + 1], value, options.step, /*refine=*/false,
-            options.max_steps, [&](double v) { return clamp(kernel + 1, v); });
+            p[kernel + 1], value, step, /*refine=*/true, options.max_steps,
+            [&](double v) { return clamp(kernel + 1, v); });
       };
-      MaximizeAlongLine(profile, best[kernel], best_value, options.step,
+      // The start is profiled too: its variance may be far off the ridge.
+      const double start_value = profile(best[kernel]);
+      MaximizeAlongLine(profile, best[kernel], start_value, step,
                         /*refine=*/true, options.max_steps,
                         [&](double v) { return clamp(kernel, v); });
     }
   }
   FromLog(best, trajectory);
   report->log_evidence = best_value;
+  std::string why;
+  const std::unique_ptr<Kernel> position =
+      CreateKernel(trajectory->position_kernel, &why);
+  const std::unique_ptr<Kernel> heading =
+      CreateKernel(trajectory->heading_kernel, &why);
+  PoseLogEvidence(likelihood, *position, *heading, &report->level);
   report->seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
           .count();

@@ -50,10 +50,11 @@ void PrintSlamSummary(const SlamOptions& options, const SlamResult& result,
     }
     *out << "\n";
     if (result.learning.evaluations > 0) {
-      *out << "  learned      by the Laplace evidence on the first "
+      *out << "  learned      by the evidence (data linearised in poses) on "
+              "the first "
            << result.learning.window_end - result.trajectory.front().t
            << " s: log evidence " << result.learning.log_evidence << ", "
-           << result.learning.evaluations << " solves, "
+           << result.learning.evaluations << " evaluations, "
            << result.learning.seconds << " s\n";
     }
   }
@@ -130,7 +131,7 @@ bool WriteSummaryJson(const SlamOptions& options, const SlamResult& result,
       << ",\n"
       << "  \"log_evidence\": " << FormatNumber(result.learning.log_evidence)
       << ",\n"
-      << "  \"learning_solves\": " << result.learning.evaluations << ",\n"
+      << "  \"learning_evaluations\": " << result.learning.evaluations << ",\n"
       << "  \"learning_rounds\": " << result.learning_rounds << ",\n"
       << "  \"prior_scale_factors\": ["
       << FormatNumber(result.prior_scale_factors[0]) << ", "

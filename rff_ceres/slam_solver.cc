@@ -761,13 +761,18 @@ bool RunSlam(const Dataset& dataset, const SlamOptions& options,
     if (!model || !FitModelToPoses(initial, model.get(), error)) return false;
   }
   if (options.prior == "rff" && incremental.every == 0 && search) {
-    if (!LearnHyperparameters(resolved, mean, initial, landmarks,
-                              options.problem, options.learning,
-                              &settled.trajectory, &result->learning, error)) {
+    // Linearised about the WNOA solve where there is one: the fit of the
+    // features to it is only as good as their starting hyperparameters.
+    const std::vector<TimedPose>& about =
+        warm.initial_poses.empty() ? initial : warm.initial_poses;
+    if (!LearnHyperparameters(resolved, mean, about, landmarks, options.problem,
+                              options.learning, &settled.trajectory,
+                              &result->learning, error)) {
       *error = "learning the hyperparameters: " + *error;
       return false;
     }
     result->learned = true;
+    mean = std::make_shared<ShiftedMean>(mean, result->learning.level);
     model = CreateTrajectoryModel(dataset, settled, mean, error);
     if (!model || !FitModelToPoses(initial, model.get(), error)) return false;
   }

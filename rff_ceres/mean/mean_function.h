@@ -4,6 +4,8 @@
 #ifndef RFF_CERES_MEAN_MEAN_FUNCTION_H_
 #define RFF_CERES_MEAN_MEAN_FUNCTION_H_
 
+#include <memory>
+#include <utility>
 #include <vector>
 
 #include "Eigen/Core"
@@ -33,6 +35,22 @@ class PiecewiseLinearMean : public MeanFunction {
  private:
   std::vector<double> times_;
   std::vector<Eigen::Vector3d> values_;
+};
+
+// A mean moved by a constant: mu(t) + offset (the level of the data learned
+// with the kernel's hyperparameters, hyperparameter_learning.h).
+class ShiftedMean : public MeanFunction {
+ public:
+  ShiftedMean(std::shared_ptr<const MeanFunction> mean,
+              const Eigen::Vector3d& offset)
+      : mean_(std::move(mean)), offset_(offset) {}
+  Eigen::Vector3d Evaluate(double t) const override {
+    return mean_->Evaluate(t) + offset_;
+  }
+
+ private:
+  std::shared_ptr<const MeanFunction> mean_;
+  Eigen::Vector3d offset_;
 };
 
 }  // namespace rff
