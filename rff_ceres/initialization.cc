@@ -27,6 +27,9 @@ constexpr double kScoreLossScale = 2.0;
 // the model's feature resolution, so the fit follows the pilot's shape.
 constexpr double kFitSigmaXy = 0.05;
 constexpr double kFitSigmaTheta = 0.05;
+// Largest step of the fit's heading targets per stage (rad): well inside
+// the pi where the wrapped residual would turn the other way.
+constexpr double kMaxHeadingStage = 0.5 * M_PI;
 
 // Observations grouped by time with the dead-reckoned pose there, for
 // scoring rotations of the dead reckoning about its start.
@@ -53,6 +56,38 @@ double HeadingCost(const std::vector<ScoredTime>& times,
     }
   }
   return cost;
+}
+
+// One MAP fit of the blocks to `poses` under the model's prior (see
+// FitModelToPoses), from the blocks' current values.
+bool FitModelToPosesOnce(const std::vector<TimedPose>& poses,
+                         TrajectoryModel* model, std::string* error) {
+  ceres::Problem problem;
+  for (int b = 0; b < model->num_blocks(); ++b) {
+    problem.AddParameterBlock(model->mutable_block(b), model->block_size(b));
+  }
+  model->AddPriorCosts(&problem);
+  const Eigen::Vector3d sigma(kFitSigmaXy, kFitSigmaXy, kFitSigmaTheta);
+  for (const TimedPose& p : poses) {
+    PoseMap map = model->PoseAt(p.t);
+    const std::vector<double*> blocks = BindPoseMaps(model, {&map});
+    problem.AddResidualBlock(
+        new PosePriorCost(std::move(map), Eigen::Vector3d(p.x, p.y, p.theta),
+                          sigma),
+        nullptr, blocks);
+  }
+  ceres::Solver::Options options;
+  options.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
+  options.max_num_iterations = 20;
+  options.logging_type = ceres::SILENT;
+  ceres::Solver::Summary summary;
+  ceres::Solve(options, &problem, &summary);
+  if (summary.termination_type == ceres::FAILURE ||
+      !std::isfinite(summary.final_cost)) {
+    *error = "fitting the initial trajectory failed: " + summary.message;
+    return false;
+  }
+  return true;
 }
 
 }  // namespace
@@ -158,30 +193,28 @@ bool FitModelToPoses(const std::vector<TimedPose>& poses,
     wnoa->SetStatesFromPoses(poses);
     return true;
   }
-  ceres::Problem problem;
-  for (int b = 0; b < model->num_blocks(); ++b) {
-    problem.AddParameterBlock(model->mutable_block(b), model->block_size(b));
+  if (poses.empty()) return true;
+  // The pose residual wraps the heading: a target more than pi from the
+  // model's heading would pull it the wrong way round. The headings are
+  // unwrapped along the poses from the model's branch and approached in
+  // stages of at most kMaxHeadingStage (a continuation).
+  std::vector<double> start(poses.size()), target(poses.size());
+  double largest_gap = 0.0;
+  for (std::size_t k = 0; k < poses.size(); ++k) {
+    start[k] = model->Pose(poses[k].t).z();
+    const double previous = k == 0 ? start[0] : target[k - 1];
+    target[k] = previous + WrapAngle(poses[k].theta - previous);
+    largest_gap = std::max(largest_gap, std::abs(target[k] - start[k]));
   }
-  model->AddPriorCosts(&problem);
-  const Eigen::Vector3d sigma(kFitSigmaXy, kFitSigmaXy, kFitSigmaTheta);
-  for (const TimedPose& p : poses) {
-    PoseMap map = model->PoseAt(p.t);
-    const std::vector<double*> blocks = BindPoseMaps(model, {&map});
-    problem.AddResidualBlock(
-        new PosePriorCost(std::move(map), Eigen::Vector3d(p.x, p.y, p.theta),
-                          sigma),
-        nullptr, blocks);
-  }
-  ceres::Solver::Options options;
-  options.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
-  options.max_num_iterations = 20;
-  options.logging_type = ceres::SILENT;
-  ceres::Solver::Summary summary;
-  ceres::Solve(options, &problem, &summary);
-  if (summary.termination_type == ceres::FAILURE ||
-      !std::isfinite(summary.final_cost)) {
-    *error = "fitting the initial trajectory failed: " + summary.message;
-    return false;
+  const int stages =
+      std::max(1, static_cast<int>(std::ceil(largest_gap / kMaxHeadingStage)));
+  for (int stage = 1; stage <= stages; ++stage) {
+    const double fraction = static_cast<double>(stage) / stages;
+    std::vector<TimedPose> staged = poses;
+    for (std::size_t k = 0; k < poses.size(); ++k) {
+      staged[k].theta = start[k] + fraction * (target[k] - start[k]);
+    }
+    if (!FitModelToPosesOnce(staged, model, error)) return false;
   }
   return true;
 }

@@ -761,8 +761,9 @@ bool RunSlam(const Dataset& dataset, const SlamOptions& options,
     if (!model || !FitModelToPoses(initial, model.get(), error)) return false;
   }
   if (options.prior == "rff" && incremental.every == 0 && search) {
-    // Linearised about the WNOA solve where there is one: the fit of the
-    // features to it is only as good as their starting hyperparameters.
+    // Linearised about (and the learned model started from) the WNOA solve
+    // where there is one: the fit of the features to it is only as good as
+    // their starting hyperparameters.
     const std::vector<TimedPose>& about =
         warm.initial_poses.empty() ? initial : warm.initial_poses;
     if (!LearnHyperparameters(resolved, mean, about, landmarks, options.problem,
@@ -774,7 +775,7 @@ bool RunSlam(const Dataset& dataset, const SlamOptions& options,
     result->learned = true;
     mean = std::make_shared<ShiftedMean>(mean, result->learning.level);
     model = CreateTrajectoryModel(dataset, settled, mean, error);
-    if (!model || !FitModelToPoses(initial, model.get(), error)) return false;
+    if (!model || !FitModelToPoses(about, model.get(), error)) return false;
   }
   double initial_extent = Extent(initial, landmarks);
   for (const LandmarkPrior& p : dataset.landmark_priors) {
