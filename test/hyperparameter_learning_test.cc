@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <memory>
+#include <ostream>
 #include <random>
 #include <string>
 #include <vector>
@@ -93,6 +94,10 @@ struct RecoveryCase {
   std::string kernel;
   double lengthscale;
 };
+
+std::ostream& operator<<(std::ostream& out, const RecoveryCase& c) {
+  return out << c.kernel << " " << c.lengthscale << " s";
+}
 
 class LearningRecoveryTest : public ::testing::TestWithParam<RecoveryCase> {};
 
