@@ -702,7 +702,7 @@ bool RunSlam(const Dataset& dataset, const SlamOptions& options,
   }
   if (!mean) {
     mean = BuildPriorMean(result->prior_mean, resolved, options.localization,
-                          error);
+                          options.spline_smoothing, error);
   }
   if (!mean) return false;
   result->mean_seconds = std::chrono::duration<double>(

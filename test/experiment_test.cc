@@ -67,17 +67,12 @@ TEST(ParseMethodsTest, RejectsUnknownEmptyAndDuplicateMethods) {
   EXPECT_EQ(error, "no method given");
 }
 
-TEST(MethodFlagfileTest, SubstitutesAndFallsBackForKitti) {
+TEST(MethodFlagfileTest, SubstitutesTheConfigsDirAndTheFamily) {
   const std::string configs = std::string(RFF_SOURCE_DIR) + "/configs";
   const Method rff{"rff", "{configs}/{family}.flags"};
   EXPECT_EQ(MethodFlagfile(rff, "plaza", configs), configs + "/plaza.flags");
-  // Until configs/kitti_bearing.flags exists, the bearing-only config.
-  const std::string kitti = MethodFlagfile(rff, "kitti_bearing", configs);
-  if (!std::filesystem::exists(configs + "/kitti_bearing.flags")) {
-    EXPECT_EQ(kitti, configs + "/synthetic_bearing.flags");
-  } else {
-    EXPECT_EQ(kitti, configs + "/kitti_bearing.flags");
-  }
+  EXPECT_EQ(MethodFlagfile(rff, "kitti_bearing", configs),
+            configs + "/kitti_bearing.flags");
   const Method other{"x", "/nowhere/{family}_x.flags"};
   EXPECT_EQ(MethodFlagfile(other, "mrclam", configs),
             "/nowhere/mrclam_x.flags");

@@ -116,8 +116,8 @@ TEST(VarianceComponentsTest, RedundanciesMatchTheExactTraces) {
   SlamOptions options;
   options.prior = "wnoa";
   std::string error;
-  const std::shared_ptr<const MeanFunction> mean =
-      BuildPriorMean("constant", dataset, options.localization, &error);
+  const std::shared_ptr<const MeanFunction> mean = BuildPriorMean(
+      "constant", dataset, options.localization, kPaperSplineSmoothing, &error);
   ASSERT_NE(mean, nullptr) << error;
   std::unique_ptr<TrajectoryModel> model =
       CreateTrajectoryModel(dataset, options, mean, &error);

@@ -573,17 +573,8 @@ bool ParseMethods(const std::string& list, std::vector<Method>* methods,
 
 std::string MethodFlagfile(const Method& method, const std::string& family,
                            const std::string& configs_dir) {
-  auto path_of = [&](const std::string& f) {
-    return Replace(Replace(method.flagfile_pattern, "{configs}", configs_dir),
-                   "{family}", f);
-  };
-  const std::string path = path_of(family);
-  // No dedicated KITTI-scale config yet: the simulated bearing-only one is
-  // the closest (same sensor model); the lead will add kitti_bearing.flags.
-  if (family == "kitti_bearing" && !std::filesystem::exists(path)) {
-    return path_of("synthetic_bearing");
-  }
-  return path;
+  return Replace(Replace(method.flagfile_pattern, "{configs}", configs_dir),
+                 "{family}", family);
 }
 
 std::string SyntheticFamily(const std::string& kind) {

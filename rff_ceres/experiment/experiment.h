@@ -33,8 +33,8 @@ struct Method {
 bool ParseMethods(const std::string& list, std::vector<Method>* methods,
                   std::string* error);
 
-// The flagfile of `method` for `family`. kitti_bearing has no config of its
-// own yet: when its file does not exist, the synthetic_bearing one is used.
+// The flagfile of `method` for `family`: its pattern with {configs} and
+// {family} substituted.
 std::string MethodFlagfile(const Method& method, const std::string& family,
                            const std::string& configs_dir);
 

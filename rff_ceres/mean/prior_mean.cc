@@ -14,9 +14,6 @@ std::vector<std::string> PriorMeanNames() {
 
 namespace {
 
-// The paper's smoothing parameter of the spline prior (III-B.2).
-constexpr double kPaperSplineSmoothing = 0.98;
-
 std::string NameList() {
   std::string list;
   const std::vector<std::string> names = PriorMeanNames();
@@ -31,12 +28,14 @@ std::string NameList() {
 std::shared_ptr<const MeanFunction> BuildPriorMean(const std::string& name,
                                                    const Dataset& dataset,
                                                    std::string* error) {
-  return BuildPriorMean(name, dataset, LocalizationOptions(), error);
+  return BuildPriorMean(name, dataset, LocalizationOptions(),
+                        kPaperSplineSmoothing, error);
 }
 
 std::shared_ptr<const MeanFunction> BuildPriorMean(
     const std::string& name, const Dataset& dataset,
-    const LocalizationOptions& localization, std::string* error) {
+    const LocalizationOptions& localization, double spline_smoothing,
+    std::string* error) {
   const std::vector<std::string> names = PriorMeanNames();
   if (std::find(names.begin(), names.end(), name) == names.end()) {
     *error = "unknown prior mean '" + name + "' (expected " + NameList() + ")";
@@ -52,13 +51,14 @@ std::shared_ptr<const MeanFunction> BuildPriorMean(
     return nullptr;
   }
   if (name == "wnoa") {
-    *error = "prior mean 'wnoa' is a solve of the WNOA prior: RunSlam builds it";
+    *error =
+        "prior mean 'wnoa' is a solve of the WNOA prior: RunSlam builds it";
     return nullptr;
   }
   // From the inputs only: observations in the mean would count twice.
   if (name == "auto") {
     return BuildPriorMean(dataset.odometry.empty() ? "constant" : "odometry",
-                          dataset, localization, error);
+                          dataset, localization, spline_smoothing, error);
   }
   if (name == "constant") {
     return std::make_shared<PiecewiseLinearMean>(
@@ -80,8 +80,8 @@ std::shared_ptr<const MeanFunction> BuildPriorMean(
   }
   // "spline": the paper's smoothing spline (III-B.2) through the
   // localisation at every observation and prior time.
-  std::shared_ptr<const MeanFunction> base =
-      BuildPriorMean("localization", dataset, localization, error);
+  std::shared_ptr<const MeanFunction> base = BuildPriorMean(
+      "localization", dataset, localization, spline_smoothing, error);
   if (!base) return nullptr;
   std::vector<double> times;
   for (const Observation& o : dataset.observations) times.push_back(o.t);
@@ -94,7 +94,7 @@ std::shared_ptr<const MeanFunction> BuildPriorMean(
     poses.push_back({t, p.x(), p.y(), p.z()});
   }
   std::shared_ptr<const MeanFunction> mean =
-      RefitSplineMean(poses, {}, kPaperSplineSmoothing, error);
+      RefitSplineMean(poses, {}, spline_smoothing, error);
   if (!mean) *error = "prior mean 'spline': " + *error;
   return mean;
 }

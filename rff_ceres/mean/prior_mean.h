@@ -21,8 +21,9 @@ std::vector<std::string> PriorMeanNames();
 // "localization": per-time localisation against the PRIOR_LANDMARK means,
 //   smoothed robustly; fused with dead reckoning when the dataset has ODOM
 //   (see localization_mean.h and docs/prior_means.md).
-// "spline": a smoothing spline (p = 0.98) through the "localization" mean at
-//   the observation times, the first round of the paper's III-B.2.
+// "spline": a smoothing spline (De Boor's p = `spline_smoothing`) through the
+//   "localization" mean at the observation times, the first round of the
+//   paper's III-B.2.
 // "constant": the earliest PRIOR_POSE at every time.
 // "wnoa": the posterior mean of the WNOA prior given the whole dataset, for
 //   the RFF prior; a solve, so RunSlam builds it (slam_solver.h) and this
@@ -33,8 +34,11 @@ std::vector<std::string> PriorMeanNames();
 // "localization" (also through "spline") uses `localization`.
 std::shared_ptr<const MeanFunction> BuildPriorMean(
     const std::string& name, const Dataset& dataset,
-    const LocalizationOptions& localization, std::string* error);
-// The same with the default LocalizationOptions.
+    const LocalizationOptions& localization, double spline_smoothing,
+    std::string* error);
+// The paper's smoothing (III-B.2).
+inline constexpr double kPaperSplineSmoothing = 0.98;
+// The same with the default LocalizationOptions and the paper's smoothing.
 std::shared_ptr<const MeanFunction> BuildPriorMean(const std::string& name,
                                                    const Dataset& dataset,
                                                    std::string* error);

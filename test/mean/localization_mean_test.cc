@@ -185,6 +185,31 @@ TEST(PriorMeanTest, LocalizationAndSplineFollowTheFixesAndAutoStaysOffData) {
   }
 }
 
+// The spline mean takes its smoothing from the caller: p = 1 interpolates
+// the localisation at the observation times, p = 0 is the straight line
+// through it (De Boor's csaps), far from the run's end.
+TEST(PriorMeanTest, SplineSmoothingReachesTheSplineMean) {
+  const Dataset dataset = NoiseFree(MeasurementKind::kRangeBearing, false);
+  std::string error;
+  const auto localization = BuildPriorMean("localization", dataset, &error);
+  const auto interpolating =
+      BuildPriorMean("spline", dataset, LocalizationOptions(), 1.0, &error);
+  const auto straight =
+      BuildPriorMean("spline", dataset, LocalizationOptions(), 0.0, &error);
+  ASSERT_TRUE(localization && interpolating && straight) << error;
+  double interpolating_gap = 0.0, straight_gap = 0.0;
+  for (const Observation& o : dataset.observations) {
+    const Eigen::Vector3d target = localization->Evaluate(o.t);
+    interpolating_gap =
+        std::max(interpolating_gap,
+                 (interpolating->Evaluate(o.t) - target).head<2>().norm());
+    straight_gap = std::max(
+        straight_gap, (straight->Evaluate(o.t) - target).head<2>().norm());
+  }
+  EXPECT_LT(interpolating_gap, 1e-6);
+  EXPECT_GT(straight_gap, 1.0);
+}
+
 TEST(PriorMeanTest, LocalizationOptionsReachTheMean) {
   // With odometry fusion switched off, the mean is the smoothed fixes alone
   // (not exact between them); with it, dead reckoning makes it exact.
@@ -193,9 +218,10 @@ TEST(PriorMeanTest, LocalizationOptionsReachTheMean) {
   fixes_only.use_odometry = false;
   std::string error;
   std::shared_ptr<const MeanFunction> fused =
-      BuildPriorMean("localization", dataset, LocalizationOptions(), &error);
-  std::shared_ptr<const MeanFunction> unfused =
-      BuildPriorMean("localization", dataset, fixes_only, &error);
+      BuildPriorMean("localization", dataset, LocalizationOptions(),
+                     kPaperSplineSmoothing, &error);
+  std::shared_ptr<const MeanFunction> unfused = BuildPriorMean(
+      "localization", dataset, fixes_only, kPaperSplineSmoothing, &error);
   ASSERT_NE(fused, nullptr) << error;
   ASSERT_NE(unfused, nullptr) << error;
   double fused_max = 0.0, unfused_max = 0.0;
@@ -218,14 +244,18 @@ TEST(PriorMeanTest, BadLocalizationOptionsAreNamedForEveryMean) {
   LocalizationOptions options;
   options.correction_smoothing = 0.0;
   std::string error;
-  EXPECT_EQ(BuildPriorMean("localization", dataset, options, &error), nullptr);
+  EXPECT_EQ(BuildPriorMean("localization", dataset, options,
+                           kPaperSplineSmoothing, &error),
+            nullptr);
   EXPECT_EQ(error,
             "prior mean 'localization': localization_correction_smoothing "
             "must be finite and > 0, got 0");
   // "auto" would localise without odometry: it must not fall back silently.
   options = LocalizationOptions();
   options.position_smoothing = std::nan("");
-  EXPECT_EQ(BuildPriorMean("auto", dataset, options, &error), nullptr);
+  EXPECT_EQ(
+      BuildPriorMean("auto", dataset, options, kPaperSplineSmoothing, &error),
+      nullptr);
   EXPECT_EQ(error,
             "prior mean 'auto': localization_position_smoothing must be "
             "finite and > 0, got nan");

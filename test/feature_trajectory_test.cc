@@ -1,0 +1,132 @@
+#include "rff_ceres/feature_trajectory.h"
+
+#include <cmath>
+#include <memory>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "gtest/gtest.h"
+#include "rff_ceres/kernels/kernel.h"
+#include "rff_ceres/mean/mean_function.h"
+
+namespace rff {
+namespace {
+
+std::shared_ptr<const MeanFunction> ZeroMean() {
+  return std::make_shared<PiecewiseLinearMean>(
+      std::vector<TimedPose>{{0.0, 0.0, 0.0, 0.0}});
+}
+
+// Prior covariance of coordinate c at t and u under b ~ N(0, I): the sum of
+// phi_t . phi_u over the terms of the two maps that share a block.
+double PriorCovariance(const FeatureTrajectory& model, int c, double t,
+                       double u) {
+  const PoseMap a = model.PoseAt(t), b = model.PoseAt(u);
+  double covariance = 0.0;
+  for (const PoseTerm& p : a.terms) {
+    for (const PoseTerm& q : b.terms) {
+      if (p.coordinate == c && q.coordinate == c && p.block == q.block) {
+        covariance += p.phi->dot(*q.phi);
+      }
+    }
+  }
+  return covariance;
+}
+
+// The weight-space prior is the kernel (paper eq. 4): with ample Hilbert
+// features on one global map, phi(t)^T phi(u) = k(t - u) for x, y and theta.
+TEST(FeatureTrajectoryTest, PriorCovarianceIsTheKernel) {
+  FeatureTrajectoryOptions options;
+  options.position_kernel = {"matern52", 4.0, 5.0};
+  options.heading_kernel = {"rbf", 0.3, 8.0};
+  options.num_position_features = 200;
+  options.num_heading_features = 200;
+  std::string error;
+  const auto model =
+      FeatureTrajectory::Create(options, ZeroMean(), 0.0, 60.0, &error);
+  ASSERT_TRUE(model) << error;
+  ASSERT_EQ(model->num_segments(), 1);
+  const auto position = CreateKernel(options.position_kernel, &error);
+  const auto heading = CreateKernel(options.heading_kernel, &error);
+  for (const double t : {10.0, 30.0, 50.0}) {
+    for (const double lag : {0.0, 1.0, 4.0, 12.0}) {
+      EXPECT_NEAR(PriorCovariance(*model, 0, t, t - lag),
+                  position->Evaluate(lag), 0.02 * 4.0)
+          << "x at " << t << ", lag " << lag;
+      EXPECT_NEAR(PriorCovariance(*model, 1, t, t - lag),
+                  position->Evaluate(lag), 0.02 * 4.0);
+      EXPECT_NEAR(PriorCovariance(*model, 2, t, t - lag),
+                  heading->Evaluate(lag), 0.02 * 0.3)
+          << "theta at " << t << ", lag " << lag;
+    }
+  }
+}
+
+// Windowed weights: the pose is continuous across the blends of segments
+// (random weights, the derivative bounded by the features' bandwidth).
+TEST(FeatureTrajectoryTest, SegmentsBlendContinuously) {
+  FeatureTrajectoryOptions options;
+  options.position_kernel = {"rbf", 4.0, 3.0};
+  options.heading_kernel = {"rbf", 0.3, 3.0};
+  options.num_position_features = 40;
+  options.num_heading_features = 40;
+  options.segment_length = 20.0;
+  options.segment_overlap = 8.0;
+  std::string error;
+  auto model =
+      FeatureTrajectory::Create(options, ZeroMean(), 0.0, 100.0, &error);
+  ASSERT_TRUE(model) << error;
+  EXPECT_EQ(model->num_segments(), 5);
+  std::mt19937_64 rng(3);
+  std::normal_distribution<double> normal;
+  for (int b = 0; b < model->num_blocks(); ++b) {
+    for (int i = 0; i < model->block_size(b); ++i) {
+      model->mutable_block(b)[i] = normal(rng);
+    }
+  }
+  const double step = 1e-4;
+  for (double t = 0.5; t < 99.5; t += 0.25) {
+    const Eigen::Vector3d jump = model->Pose(t + step) - model->Pose(t);
+    EXPECT_LT(jump.cwiseAbs().maxCoeff(), 20.0 * step) << "at t " << t;
+  }
+}
+
+// Capacity follows the lengthscale: segments of 10 lengthscales, each with
+// about the same number of features (the same number of lengthscales to
+// cover at the same tolerance), whatever the lengthscale in seconds.
+TEST(FeatureTrajectoryTest, AutoCapacityFollowsTheLengthscale) {
+  FeatureTrajectoryOptions options;
+  options.num_position_features = kAutoCapacity;
+  options.num_heading_features = kAutoCapacity;
+  options.position_kernel = {"matern52", 25.0, 8.0};
+  options.heading_kernel = {"matern52", 0.25, 12.0};
+  const FeatureTrajectoryOptions long_scale = AutoCapacity(options, 600.0);
+  EXPECT_DOUBLE_EQ(long_scale.segment_length, 80.0);
+  EXPECT_DOUBLE_EQ(long_scale.segment_overlap, 32.0);
+  options.position_kernel.lengthscale = 2.0;
+  const FeatureTrajectoryOptions short_scale = AutoCapacity(options, 600.0);
+  EXPECT_DOUBLE_EQ(short_scale.segment_length, 20.0);
+  EXPECT_GT(long_scale.num_position_features, 20);
+  EXPECT_NEAR(short_scale.num_position_features,
+              long_scale.num_position_features, 3);
+  // A run shorter than 1.5 segments: one global map.
+  EXPECT_DOUBLE_EQ(AutoCapacity(options, 25.0).segment_length, 0.0);
+  // Given capacities are kept.
+  options.num_position_features = 7;
+  EXPECT_EQ(AutoCapacity(options, 600.0).num_position_features, 7);
+}
+
+TEST(FeatureTrajectoryTest, OverlapNotShorterThanTheSegmentFails) {
+  FeatureTrajectoryOptions options;
+  options.segment_length = 10.0;
+  options.segment_overlap = 10.0;
+  std::string error;
+  EXPECT_EQ(FeatureTrajectory::Create(options, ZeroMean(), 0.0, 50.0, &error),
+            nullptr);
+  EXPECT_EQ(error,
+            "segment length and overlap must be >= 0, with overlap < length");
+}
+
+}  // namespace
+}  // namespace rff
