@@ -44,7 +44,8 @@ TEST(SlamSolverTest, RangeBearingWithOdometryBeatsDeadReckoningByFar) {
     errors.push_back(ApeTranslation(dataset, result));
   }
   std::sort(errors.begin(), errors.end());
-  // The bar for sigma_r = 1 m, sigma_b = 2 deg with odometry.
+  // The paper's protocol (sigma_r = 1 m, sigma_b = 2 deg, odometry): a
+  // dense RFF implementation's median is 0.61 m (shared synthetic README).
   EXPECT_LT(errors[1], 0.6)
       << errors[0] << " " << errors[1] << " " << errors[2];
 }
