@@ -1,5 +1,5 @@
-// Angle wrapping for residuals (kept free of the library so that costs
-// depend on nothing but Eigen and Ceres).
+// Angle wrapping, for the residuals and for the library (here, so that the
+// costs depend on nothing but Eigen and Ceres).
 #ifndef RFF_COSTS_ANGLE_H_
 #define RFF_COSTS_ANGLE_H_
 
@@ -8,8 +8,8 @@
 namespace rff {
 
 // Wraps an angle to (-pi, pi]: residuals on the circle are measured along
-// the shortest arc.
-inline double WrapAngleResidual(double angle) {
+// the shortest arc. remainder() maps to [-pi, pi]; -pi folds onto pi.
+inline double WrapAngle(double angle) {
   double wrapped = std::remainder(angle, 2.0 * M_PI);
   if (wrapped <= -M_PI) wrapped += 2.0 * M_PI;
   return wrapped;

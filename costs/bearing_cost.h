@@ -48,7 +48,7 @@ class BearingCost : public PoseCost<1, 1, true> {
                             &d_landmark)) {
       return false;
     }
-    (*r)(0) = WrapAngleResidual(predicted - bearing_) * inv_sigma_;
+    (*r)(0) = WrapAngle(predicted - bearing_) * inv_sigma_;
     if (dr_dposes == nullptr) return true;
     (*dr_dposes)[0] = d_pose.transpose() * inv_sigma_;
     *dr_dlandmark = d_landmark.transpose() * inv_sigma_;

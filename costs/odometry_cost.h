@@ -42,7 +42,7 @@ class OdometryCost : public PoseCost<3, 2, false> {
     const double dy = -s * d.x() + c * d.y();
     const Eigen::Vector3d error(
         dx - motion_.x(), dy - motion_.y(),
-        WrapAngleResidual(poses[1].z() - poses[0].z() - motion_.z()));
+        WrapAngle(poses[1].z() - poses[0].z() - motion_.z()));
     *r = sqrt_information_ * error;
     if (dr_dposes == nullptr) return true;
     // d(dx, dy)/d p1 = R^T, d/d p0 = -R^T, d/d theta0 = (dy, -dx).

@@ -24,7 +24,7 @@ class PosePriorCost : public PoseCost<3, 1, false> {
                 std::array<PoseGradient, 1>* dr_dposes,
                 LandmarkGradient* /*dr_dlandmark*/) const override {
     Eigen::Vector3d error = poses[0] - prior_;
-    error.z() = WrapAngleResidual(error.z());
+    error.z() = WrapAngle(error.z());
     *r = inv_sigma_.cwiseProduct(error);
     if (dr_dposes != nullptr) {
       (*dr_dposes)[0] = inv_sigma_.asDiagonal();

@@ -38,7 +38,7 @@ class RangeBearingCost : public PoseCost<2, 1, true> {
       return false;
     }
     (*r)(0) = (range - range_) * inv_sigma_range_;
-    (*r)(1) = WrapAngleResidual(bearing - bearing_) * inv_sigma_bearing_;
+    (*r)(1) = WrapAngle(bearing - bearing_) * inv_sigma_bearing_;
     if (dr_dposes == nullptr) return true;
     (*dr_dposes)[0].row(0) = dr_pose.transpose() * inv_sigma_range_;
     (*dr_dposes)[0].row(1) = db_pose.transpose() * inv_sigma_bearing_;

@@ -159,13 +159,6 @@ std::string JsonString(const std::string& text) {
   return out + "\"";
 }
 
-double WrapAngle(double angle) {
-  // remainder() maps to [-pi, pi]; fold -pi onto pi for (-pi, pi].
-  double wrapped = std::remainder(angle, 2.0 * M_PI);
-  if (wrapped <= -M_PI) wrapped += 2.0 * M_PI;
-  return wrapped;
-}
-
 bool OpenForReading(const std::string& path, std::ifstream* stream,
                     std::string* error) {
   stream->open(path, std::ios::in | std::ios::binary);

@@ -15,6 +15,8 @@
 #include <string_view>
 #include <vector>
 
+#include "costs/angle.h"  // WrapAngle, for the readers and writers.
+
 namespace rff {
 
 // Longest line a reader accepts; anything longer is binary junk or a broken
@@ -78,9 +80,6 @@ std::string FormatNumber(double value);
 // `text` as a JSON string literal, quotes included, with '"', '\\' and
 // control characters escaped.
 std::string JsonString(const std::string& text);
-
-// Wraps an angle to (-pi, pi].
-double WrapAngle(double angle);
 
 // Opens `path` for reading; on failure sets `error` ("cannot open ...").
 bool OpenForReading(const std::string& path, std::ifstream* stream,

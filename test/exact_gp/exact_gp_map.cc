@@ -107,9 +107,9 @@ class WhitenedProblem {
   Eigen::MatrixXd Trajectory(const Eigen::VectorXd& p) const {
     Eigen::MatrixXd f(n_, kDims);
     for (int d = 0; d < kDims; ++d) {
-      f.col(d) = factor(d).triangularView<Eigen::Lower>() *
-                     p.segment(d * n_, n_) +
-                 Eigen::VectorXd::Constant(n_, mean_(d));
+      f.col(d) =
+          factor(d).triangularView<Eigen::Lower>() * p.segment(d * n_, n_) +
+          Eigen::VectorXd::Constant(n_, mean_(d));
     }
     return f;
   }
@@ -183,7 +183,7 @@ class WhitenedProblem {
           return false;
         }
         const double inverse = 1.0 / o.sigma_bearing;
-        b.r(b.rows) = WrapAngleResidual(bearing - o.bearing) * inverse;
+        b.r(b.rows) = WrapAngle(bearing - o.bearing) * inverse;
         b.d_pose.row(b.rows) = d_pose.transpose() * inverse;
         b.d_landmark.row(b.rows) = d_landmark.transpose() * inverse;
         ++b.rows;
@@ -204,10 +204,10 @@ class WhitenedProblem {
       const int i = time_index_.at(prior.pose.t);
       const Eigen::Vector3d inverse(1.0 / prior.sigma_xy, 1.0 / prior.sigma_xy,
                                     1.0 / prior.sigma_theta);
-      Eigen::Vector3d error = f.row(i).transpose() -
-                              Eigen::Vector3d(prior.pose.x, prior.pose.y,
-                                              prior.pose.theta);
-      error.z() = WrapAngleResidual(error.z());
+      Eigen::Vector3d error =
+          f.row(i).transpose() -
+          Eigen::Vector3d(prior.pose.x, prior.pose.y, prior.pose.theta);
+      error.z() = WrapAngle(error.z());
       const Eigen::Vector3d r = inverse.cwiseProduct(error);
       total += 0.5 * r.squaredNorm();
       if (derivatives) {
@@ -335,7 +335,8 @@ bool PositionNees(const Dataset& dataset, const ExactGpResult& result,
   for (std::size_t i = 0; i < times.size(); ++i) {
     const Eigen::Vector2d e(result.trajectory[i].x - truth[i].x,
                             result.trajectory[i].y - truth[i].y);
-    const Eigen::Matrix2d sigma = result.pose_covariances[i].topLeftCorner<2, 2>();
+    const Eigen::Matrix2d sigma =
+        result.pose_covariances[i].topLeftCorner<2, 2>();
     sum += e.dot(sigma.ldlt().solve(e));
   }
   *nees = sum / times.size();
@@ -425,8 +426,8 @@ bool SolveExactGpMap(
     const Eigen::VectorXd step = ldlt.solve(-gradient);
     const Eigen::VectorXd candidate = p + step;
     double candidate_cost;
-    const bool finite = problem.Evaluate(candidate, &candidate_cost, nullptr,
-                                         nullptr);
+    const bool finite =
+        problem.Evaluate(candidate, &candidate_cost, nullptr, nullptr);
     // Gain ratio: actual over predicted decrease of the quadratic model.
     const double predicted =
         -(gradient.dot(step) + 0.5 * step.dot(hessian * step));
@@ -477,8 +478,7 @@ bool SolveExactGpMapFromGroundTruth(const Dataset& dataset,
   const std::vector<double> times = ExactGpTimes(dataset);
   std::vector<Eigen::Vector3d> poses;
   std::map<LandmarkId, Eigen::Vector2d> landmarks;
-  if (!InitialGuessFromGroundTruth(dataset, times, &poses, &landmarks,
-                                   error) ||
+  if (!InitialGuessFromGroundTruth(dataset, times, &poses, &landmarks, error) ||
       !SolveExactGpMap(dataset, options, poses, landmarks, result, error)) {
     return false;
   }
