@@ -132,6 +132,9 @@ bool WriteSummaryJson(const SlamOptions& options, const SlamResult& result,
       << "  \"log_evidence\": " << FormatNumber(result.learning.log_evidence)
       << ",\n"
       << "  \"learning_evaluations\": " << result.learning.evaluations << ",\n"
+      << "  \"learned_level\": [" << FormatNumber(result.learning.level.x())
+      << ", " << FormatNumber(result.learning.level.y()) << ", "
+      << FormatNumber(result.learning.level.z()) << "],\n"
       << "  \"learning_rounds\": " << result.learning_rounds << ",\n"
       << "  \"prior_scale_factors\": ["
       << FormatNumber(result.prior_scale_factors[0]) << ", "

@@ -3,19 +3,23 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <fstream>
 #include <memory>
 #include <ostream>
 #include <random>
+#include <sstream>
 #include <string>
 #include <vector>
 
 #include "Eigen/Dense"
 #include "gtest/gtest.h"
+#include "rff_ceres/io/text_parser.h"
 #include "rff_ceres/kernels/kernel.h"
 #include "rff_ceres/mean/prior_mean.h"
 #include "rff_ceres/pose_evidence.h"
 #include "rff_ceres/simulate.h"
 #include "rff_ceres/simulate_gp_draw.h"
+#include "rff_ceres/slam_report.h"
 #include "rff_ceres/slam_solver.h"
 
 namespace rff {
@@ -152,6 +156,45 @@ INSTANTIATE_TEST_SUITE_P(
       return info.param.kernel + "_" +
              std::to_string(static_cast<int>(info.param.lengthscale)) + "s";
     });
+
+// The default solve of a run without odometry learns (RFF prior, the
+// truth's kernel only): the summary JSON carries the learned values under
+// the flags' names, the objective and the level the mean moved to.
+TEST(LearningRunSlamTest, DefaultSolveLearnsAndReportsTheValues) {
+  SimulationOptions simulation = GpDrawOptions(311);
+  simulation.num_steps = 300;
+  simulation.gp_kernel = "rbf";
+  Dataset dataset;
+  std::string error;
+  ASSERT_TRUE(Simulate(simulation, &dataset, &error)) << error;
+  SlamOptions options;
+  options.trajectory.position_kernel.name = "rbf";
+  options.trajectory.heading_kernel.name = "rbf";
+  SlamResult result;
+  ASSERT_TRUE(RunSlam(dataset, options, &result, &error)) << error;
+  EXPECT_TRUE(result.learned);
+  EXPECT_EQ(result.initial_trajectory, "wnoa");
+  EXPECT_GT(result.learning.evaluations, 10);
+  EXPECT_TRUE(result.learning.level.allFinite());
+  const double lengthscale =
+      result.trajectory_options.position_kernel.lengthscale;
+  EXPECT_NEAR(lengthscale, 8.0, 0.3 * 8.0);
+
+  const std::string path = testing::TempDir() + "/learning_summary.json";
+  ASSERT_TRUE(WriteSummaryJson(options, result, path, &error)) << error;
+  std::ifstream in(path);
+  std::stringstream json;
+  json << in.rdbuf();
+  EXPECT_NE(json.str().find("\"learn_hyperparameters\": true"),
+            std::string::npos);
+  EXPECT_NE(json.str().find("\"lengthscale\": " + FormatNumber(lengthscale)),
+            std::string::npos)
+      << json.str();
+  EXPECT_NE(json.str().find("\"log_evidence\": " +
+                            FormatNumber(result.learning.log_evidence)),
+            std::string::npos);
+  EXPECT_NE(json.str().find("\"learned_level\": ["), std::string::npos);
+}
 
 }  // namespace
 }  // namespace rff
