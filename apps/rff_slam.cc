@@ -59,10 +59,11 @@ int main(int argc, char** argv) {
   if (FLAGS_dataset.empty()) return Fail("--dataset is required");
 
   std::string error;
-  rff::Dataset dataset;
-  if (!rff::ReadDataset(FLAGS_dataset, &dataset, &error)) return Fail(error);
   rff::SlamOptions options = rff::SlamOptionsFromFlags();
   options.compute_covariance = !FLAGS_output_covariance.empty();
+  if (!rff::ValidateSlamOptions(options, &error)) return Fail(error);
+  rff::Dataset dataset;
+  if (!rff::ReadDataset(FLAGS_dataset, &dataset, &error)) return Fail(error);
   rff::SlamResult result;
   if (!rff::RunSlam(dataset, options, &result, &error)) {
     return Fail(FLAGS_dataset + ": " + error);
@@ -97,7 +98,6 @@ int main(int argc, char** argv) {
     }
     rff::PrintEvaluation(evaluation, &std::cout);
   }
-  std::cerr << "rff_slam: quality " << rff::QualityLine(result.quality)
-            << "\n";
+  std::cerr << "rff_slam: quality " << rff::QualityLine(result.quality) << "\n";
   return FLAGS_fail_on_suspect && result.quality.suspect() ? 3 : 0;
 }

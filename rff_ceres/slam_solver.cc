@@ -619,46 +619,8 @@ bool RunSlam(const Dataset& dataset, const SlamOptions& options,
   *result = SlamResult();
   ceres::Solver::Options ceres_options;
   if (!ToCeresOptions(options.solver, &ceres_options, error)) return false;
-  if (options.learn_hyperparameters != "auto" &&
-      options.learn_hyperparameters != "on" &&
-      options.learn_hyperparameters != "off") {
-    *error = "learn_hyperparameters must be auto, on or off, got '" +
-             options.learn_hyperparameters + "'";
-    return false;
-  }
-  if (options.initial_trajectory != "auto" &&
-      options.initial_trajectory != "mean") {
-    *error = "initial_trajectory must be auto or mean, got '" +
-             options.initial_trajectory + "'";
-    return false;
-  }
-  if (options.outer_rounds < 0) {
-    *error = "outer_rounds must be >= 0, got " +
-             std::to_string(options.outer_rounds);
-    return false;
-  }
-  if (!(options.spline_smoothing >= 0.0 && options.spline_smoothing <= 1.0)) {
-    *error = "spline_smoothing must be in [0, 1], got " +
-             FormatNumber(options.spline_smoothing);
-    return false;
-  }
+  if (!ValidateSlamOptions(options, error)) return false;
   const IncrementalOptions& incremental = options.incremental;
-  if (incremental.every < 0) {
-    *error = "incremental_every must be >= 0, got " +
-             std::to_string(incremental.every);
-    return false;
-  }
-  if (!(incremental.lag >= 0.0) || !std::isfinite(incremental.lag)) {
-    *error = "incremental_lag must be finite and >= 0, got " +
-             FormatNumber(incremental.lag);
-    return false;
-  }
-  if (incremental.every > 0 && options.outer_rounds > 0) {
-    *error =
-        "outer_rounds (spline refits of the whole run) cannot be "
-        "combined with the incremental mode";
-    return false;
-  }
   if (dataset.observations.empty() && dataset.odometry.empty()) {
     *error =
         "the dataset has no observations and no odometry: nothing to "
@@ -666,19 +628,9 @@ bool RunSlam(const Dataset& dataset, const SlamOptions& options,
     return false;
   }
 
-  // Every mean and pilot checks these; before any solve, in the user's terms.
-  if (!CheckLocalizationOptions(options.localization, error)) {
-    *error = "prior mean '" + options.prior_mean + "': " + *error;
-    return false;
-  }
-
   // The start (heading, pilot) may come from the data.
   const Dataset resolved = ResolveStartHeading(dataset, &result->start_heading);
   result->prior_mean = SettlePriorMean(options, dataset);
-  if (result->prior_mean == "wnoa" && options.prior != "rff") {
-    *error = "prior mean 'wnoa' is for the rff prior";
-    return false;
-  }
   // The RFF prior starts from a WNOA solve: as its mean with a "wnoa" mean;
   // as its initial value without odometry, where the localisation pilot
   // has no motion model to bridge gaps between fixes.

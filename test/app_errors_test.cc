@@ -228,7 +228,14 @@ const AppCase kAppCases[] = {
      "finite and > 0, got -1",
      "{dir}/out.tum"},
     {"SlamUnknownPriorMean", SLAM "--prior_mean=psychic" SLAM_OUT,
-     "unknown prior mean 'psychic'", "{dir}/out.tum"},
+     "prior_mean must be auto, odometry, wnoa, localization, spline or "
+     "constant, got 'psychic'",
+     "{dir}/out.tum"},
+    // Options are checked before the dataset is read.
+    {"SlamBadOptionBeforeMissingDataset",
+     "{bin}/rff_slam --dataset={dir}/missing.rffd --prior=brownian" SLAM_OUT,
+     "rff_slam: error: prior must be rff or wnoa, got 'brownian'",
+     "{dir}/out.tum"},
     {"SlamNegativeOuterRounds", SLAM "--outer_rounds=-1" SLAM_OUT,
      "outer_rounds must be >= 0, got -1", "{dir}/out.tum"},
     {"SlamSplineSmoothingAboveOne", SLAM "--spline_smoothing=2" SLAM_OUT,
@@ -409,10 +416,10 @@ TEST(AppQualityTest, SuspectVerdictExitsThreeOnlyWhenAsked) {
               HasSubstr("\"quality\": \"suspect\""));
   EXPECT_TRUE(std::filesystem::exists(dir + "/out.tum"));
 
-  run = RunCommand(Expand(
-      "{bin}/rff_slam --output_trajectory={dir}/out.tum "
-      "--dataset={dir}/backwards.rffd",
-      dir));
+  run =
+      RunCommand(Expand("{bin}/rff_slam --output_trajectory={dir}/out.tum "
+                        "--dataset={dir}/backwards.rffd",
+                        dir));
   EXPECT_EQ(run.exit_code, 0) << run.output;
   EXPECT_THAT(run.output, HasSubstr("rff_slam: quality suspect: "));
 }

@@ -183,7 +183,7 @@ INSTANTIATE_TEST_SUITE_P(
                   [](SlamOptions* o) { o->spline_smoothing = 1.5; },
                   "spline_smoothing must be in [0, 1]"},
         BadOption{"UnknownPrior", [](SlamOptions* o) { o->prior = "brownian"; },
-                  "unknown prior 'brownian' (expected rff or wnoa)"},
+                  "prior must be rff or wnoa, got 'brownian'"},
         BadOption{"NegativeWnoaQc",
                   [](SlamOptions* o) {
                     o->prior = "wnoa";
@@ -198,7 +198,21 @@ INSTANTIATE_TEST_SUITE_P(
                   "incremental_lag must be finite and >= 0"},
         BadOption{"UnknownPriorMean",
                   [](SlamOptions* o) { o->prior_mean = "psychic"; },
-                  "unknown prior mean 'psychic'"}),
+                  "prior_mean must be auto, odometry, wnoa, localization, "
+                  "spline or constant, got 'psychic'"},
+        // Each prior's options are checked whichever prior is chosen.
+        BadOption{"WnoaQcCheckedWithTheRffPrior",
+                  [](SlamOptions* o) {
+                    o->prior = "rff";
+                    o->wnoa.position_qc = -1.0;
+                  },
+                  "wnoa position_qc must be > 0, got -1"},
+        BadOption{"KernelCheckedWithTheWnoaPrior",
+                  [](SlamOptions* o) {
+                    o->prior = "wnoa";
+                    o->trajectory.heading_kernel.name = "sinc";
+                  },
+                  "unknown kernel 'sinc'"}),
     [](const ::testing::TestParamInfo<BadOption>& info) {
       return std::string(info.param.name);
     });
