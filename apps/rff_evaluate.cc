@@ -2,12 +2,14 @@
 // and optional landmark file against the ground truth of a .rffd dataset.
 //
 //   rff_evaluate --dataset=IN.rffd --trajectory=EST.tum
-//                [--landmarks=EST.landmarks] [--align] [--json=OUT.json]
+//                [--landmarks=EST.landmarks] [--covariance=EST.cov] [--align]
+//                [--json=OUT.json]
 #include <iostream>
 #include <string>
 #include <vector>
 
 #include "gflags/gflags.h"
+#include "rff_ceres/consistency.h"
 #include "rff_ceres/io/dataset_io.h"
 #include "rff_ceres/io/landmarks_io.h"
 #include "rff_ceres/io/tum_io.h"
@@ -20,6 +22,11 @@ DEFINE_bool(align, false,
             "Align the estimate onto the ground truth (least-squares SE(2), "
             "positions) before computing the errors.");
 DEFINE_string(json, "", "Also write the metrics as JSON to this file.");
+DEFINE_string(covariance, "",
+              "Pose covariances of the estimate (rff_slam "
+              "--output_covariance), optional: adds the consistency (mean "
+              "NEES of position and heading, coverage of the 68/95/99% "
+              "regions).");
 
 namespace {
 
@@ -33,7 +40,8 @@ int Fail(const std::string& message) {
 int main(int argc, char** argv) {
   gflags::SetUsageMessage(
       "rff_evaluate --dataset=IN.rffd --trajectory=EST.tum "
-      "[--landmarks=EST.landmarks] [--align] [--json=OUT.json]");
+      "[--landmarks=EST.landmarks] [--covariance=EST.cov] [--align] "
+      "[--json=OUT.json]");
   gflags::ParseCommandLineFlags(&argc, &argv, true);
   if (argc > 1)
     return Fail(std::string("unexpected argument '") + argv[1] + "'");
@@ -55,6 +63,11 @@ int main(int argc, char** argv) {
     return Fail(error);
   }
 
+  std::vector<rff::PoseCovariance> covariances;
+  if (!FLAGS_covariance.empty() &&
+      !rff::ReadPoseCovariances(FLAGS_covariance, &covariances, &error)) {
+    return Fail(error);
+  }
   rff::EvaluationOptions options;
   options.align = FLAGS_align;
   rff::Evaluation evaluation;
@@ -62,6 +75,11 @@ int main(int argc, char** argv) {
                      trajectory, FLAGS_landmarks.empty() ? nullptr : &landmarks,
                      options, &evaluation, &error)) {
     return Fail(FLAGS_trajectory + ": " + error);
+  }
+  if (!FLAGS_covariance.empty() &&
+      !rff::EvaluateConsistency(dataset.ground_truth, trajectory, covariances,
+                                &evaluation, &error)) {
+    return Fail(FLAGS_covariance + ": " + error);
   }
   std::cout << "dataset: " << FLAGS_dataset
             << "\ntrajectory: " << FLAGS_trajectory << "\n";
@@ -75,6 +93,8 @@ int main(int argc, char** argv) {
         {"dataset", FLAGS_dataset}, {"trajectory", FLAGS_trajectory}};
     if (!FLAGS_landmarks.empty())
       inputs.push_back({"landmarks", FLAGS_landmarks});
+    if (!FLAGS_covariance.empty())
+      inputs.push_back({"covariance", FLAGS_covariance});
     if (!rff::WriteEvaluationJson(evaluation, inputs, FLAGS_json, &error)) {
       return Fail(error);
     }

@@ -330,6 +330,19 @@ void PrintEvaluation(const Evaluation& evaluation, std::ostream* output) {
     *output << "; " << landmarks.unmatched_estimates
             << " estimates without ground truth\n";
   }
+  const ConsistencySummary& c = evaluation.consistency;
+  if (c.evaluated) {
+    char buffer[320];
+    std::snprintf(buffer, sizeof(buffer),
+                  "consistency: %d poses; position NEES mean %.3f (ideal 2), "
+                  "inside the 68/95/99%% regions %.3f/%.3f/%.3f; heading "
+                  "NEES mean %.3f (ideal 1), inside %.3f/%.3f/%.3f\n",
+                  c.count, c.mean_position_nees, c.position_coverage[0],
+                  c.position_coverage[1], c.position_coverage[2],
+                  c.mean_heading_nees, c.heading_coverage[0],
+                  c.heading_coverage[1], c.heading_coverage[2]);
+    *output << buffer;
+  }
 }
 
 void WriteEvaluationJson(
@@ -379,6 +392,21 @@ void WriteEvaluationJson(
     }
     *output << "],\n  \"landmark_unmatched_estimates\": "
             << landmarks.unmatched_estimates;
+  }
+  const ConsistencySummary& c = evaluation.consistency;
+  if (c.evaluated) {
+    *output << ",\n  \"consistency_count\": " << c.count
+            << ",\n  \"mean_position_nees\": "
+            << FormatNumber(c.mean_position_nees)
+            << ",\n  \"mean_heading_nees\": "
+            << FormatNumber(c.mean_heading_nees);
+    const char* levels[] = {"68", "95", "99"};
+    for (int k = 0; k < 3; ++k) {
+      *output << ",\n  \"position_coverage_" << levels[k]
+              << "\": " << FormatNumber(c.position_coverage[k])
+              << ",\n  \"heading_coverage_" << levels[k]
+              << "\": " << FormatNumber(c.heading_coverage[k]);
+    }
   }
   *output << "\n}\n";
 }

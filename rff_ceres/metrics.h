@@ -5,6 +5,7 @@
 #ifndef RFF_CERES_METRICS_H_
 #define RFF_CERES_METRICS_H_
 
+#include <array>
 #include <ostream>
 #include <string>
 #include <utility>
@@ -69,6 +70,21 @@ struct LandmarkEvaluation {
   ErrorSummary distance;  // Metres, over the matched landmarks.
 };
 
+// Consistency of pose covariances with the errors they claim: the
+// normalised estimation error squared e^T P^-1 e per ground-truth pose
+// (Bar-Shalom, Li & Kirubarajan 2001, 5.4), of the position (2 degrees of
+// freedom, ideal mean 2) and of the heading (1, ideal mean 1), and the share
+// of poses inside the regions that should hold 68.27%, 95% and 99% of them.
+struct ConsistencySummary {
+  bool evaluated = false;  // Whether covariances were given.
+  int count = 0;
+  double mean_position_nees = 0.0;
+  double mean_heading_nees = 0.0;
+  std::array<double, 3> position_coverage = {0.0, 0.0, 0.0};
+  std::array<double, 3> heading_coverage = {0.0, 0.0, 0.0};
+};
+inline constexpr std::array<double, 3> kCoverageLevels = {0.6827, 0.95, 0.99};
+
 struct EvaluationOptions {
   // Apply the least-squares SE(2) alignment of the estimated positions onto
   // the ground-truth positions before computing every error.
@@ -87,6 +103,7 @@ struct Evaluation {
   ErrorSummary rpe_translation;  // Metres, consecutive ground-truth times.
   ErrorSummary rpe_rotation;     // Radians.
   LandmarkEvaluation landmarks;
+  ConsistencySummary consistency;  // See EvaluateConsistency.
 };
 
 // Evaluates `estimate` (strictly increasing times) against `ground_truth`

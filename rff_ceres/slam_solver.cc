@@ -476,14 +476,14 @@ bool SolveIncremental(const Dataset& dataset, const SlamOptions& options,
 }
 
 // The WNOA solve the RFF prior starts from: a batch solve of its own with
-// the same problem options.
+// the same problem options, with its covariance when `covariance`.
 bool SolveWnoa(const Dataset& dataset, const SlamOptions& options,
-               SlamResult* solve, std::string* error) {
+               bool covariance, SlamResult* solve, std::string* error) {
   SlamOptions wnoa = options;
   wnoa.prior = "wnoa";
   wnoa.prior_mean = "auto";
   wnoa.outer_rounds = 0;
-  wnoa.compute_covariance = false;
+  wnoa.compute_covariance = covariance;
   // The user's linear solver is for the RFF solve; banded states want their
   // own (AutoLinearSolverType).
   wnoa.solver.linear_solver = "auto";
@@ -603,6 +603,34 @@ bool LearnPriorScales(const Dataset& dataset,
   return true;
 }
 
+// Adds the covariance of a mean that is itself an estimate (the WNOA
+// solve, at the same output times) to that of the correction around it: the
+// RFF weights then carry what the data leave after the mean (about nothing,
+// docs/uncertainty.md), and the mean carries the rest. No-op without one.
+bool AddMeanCovariance(const SlamResult& mean, SlamResult* result,
+                       std::string* error) {
+  if (mean.pose_covariances.empty()) return true;
+  if (mean.pose_covariances.size() != result->pose_covariances.size()) {
+    *error = "the WNOA mean has covariances at " +
+             std::to_string(mean.pose_covariances.size()) + " times, the " +
+             "estimate at " + std::to_string(result->pose_covariances.size());
+    return false;
+  }
+  for (std::size_t i = 0; i < mean.pose_covariances.size(); ++i) {
+    result->pose_covariances[i] += mean.pose_covariances[i];
+  }
+  std::map<LandmarkId, const Landmark*> by_id;
+  for (const Landmark& l : mean.landmarks) by_id[l.id] = &l;
+  for (Landmark& l : result->landmarks) {
+    const auto it = by_id.find(l.id);
+    if (it == by_id.end() || !it->second->has_covariance) continue;
+    l.sxx += it->second->sxx;
+    l.sxy += it->second->sxy;
+    l.syy += it->second->syy;
+  }
+  return true;
+}
+
 }  // namespace
 
 std::string SettlePriorMean(const SlamOptions& options,
@@ -635,6 +663,8 @@ bool RunSlam(const Dataset& dataset, const SlamOptions& options,
   // as its initial value without odometry, where the localisation pilot
   // has no motion model to bridge gaps between fixes.
   SlamOptions warm = options;
+  // A "wnoa" mean is an estimate: its covariance joins the correction's.
+  SlamResult mean_covariance;
   const auto mean_start = std::chrono::steady_clock::now();
   std::shared_ptr<const MeanFunction> mean;
   if (options.prior == "rff" && incremental.every == 0 &&
@@ -642,9 +672,14 @@ bool RunSlam(const Dataset& dataset, const SlamOptions& options,
        (dataset.odometry.empty() && options.initial_trajectory == "auto" &&
         options.initial_poses.empty()))) {
     SlamResult wnoa;
-    if (!SolveWnoa(dataset, options, &wnoa, error)) return false;
-    if (result->prior_mean == "wnoa") {
+    const bool wnoa_mean = result->prior_mean == "wnoa";
+    if (!SolveWnoa(dataset, options, wnoa_mean && options.compute_covariance,
+                   &wnoa, error)) {
+      return false;
+    }
+    if (wnoa_mean) {
       mean = std::make_shared<PiecewiseLinearMean>(wnoa.trajectory);
+      mean_covariance = std::move(wnoa);
     } else {
       warm.initial_poses = wnoa.trajectory;
       for (const Landmark& l : wnoa.landmarks) {
@@ -782,7 +817,8 @@ bool RunSlam(const Dataset& dataset, const SlamOptions& options,
     covariance_options.num_threads = options.solver.num_threads;
     if (!ComputePosteriorCovariance(
             problem.get(), *model, times, covariance_options,
-            &result->pose_covariances, &result->landmarks, error)) {
+            &result->pose_covariances, &result->landmarks, error) ||
+        !AddMeanCovariance(mean_covariance, result, error)) {
       return false;
     }
   }

@@ -393,5 +393,30 @@ TEST(PosteriorCovarianceCalibrationTest, OneSolveTwoSigmaHoldAbout95Percent) {
   EXPECT_LE(coverage.landmark_fraction(), 0.99);
 }
 
+// The RFF default with odometry is a correction around a WNOA solve: its
+// pose covariance is the WNOA solve's plus the correction's, never the
+// correction's alone (which was 300x over-confident on Plaza 1).
+TEST(WnoaMeanCovarianceTest, RffCovarianceContainsTheWnoaSolves) {
+  SimulationOptions simulation = PaperOptions(3);
+  simulation.num_steps = 120;
+  Dataset dataset;
+  std::string error;
+  ASSERT_TRUE(Simulate(simulation, &dataset, &error)) << error;
+  SlamOptions options;
+  options.compute_covariance = true;
+  SlamResult rff, wnoa;
+  ASSERT_TRUE(RunSlam(dataset, options, &rff, &error)) << error;
+  ASSERT_EQ(rff.prior_mean, "wnoa");
+  options.prior = "wnoa";
+  ASSERT_TRUE(RunSlam(dataset, options, &wnoa, &error)) << error;
+  ASSERT_EQ(rff.pose_covariances.size(), wnoa.pose_covariances.size());
+  for (std::size_t i = 0; i < rff.pose_covariances.size(); ++i) {
+    const double ratio = rff.pose_covariances[i].topLeftCorner<2, 2>().trace() /
+                         wnoa.pose_covariances[i].topLeftCorner<2, 2>().trace();
+    EXPECT_GE(ratio, 1.0) << "pose " << i;
+    EXPECT_LE(ratio, 1.5) << "pose " << i;
+  }
+}
+
 }  // namespace
 }  // namespace rff
