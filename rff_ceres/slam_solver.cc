@@ -664,7 +664,7 @@ bool RunSlam(const Dataset& dataset, const SlamOptions& options,
   // has no motion model to bridge gaps between fixes.
   SlamOptions warm = options;
   // A "wnoa" mean is an estimate: its covariance joins the correction's.
-  SlamResult mean_covariance;
+  SlamResult wnoa_mean_solve;
   const auto mean_start = std::chrono::steady_clock::now();
   std::shared_ptr<const MeanFunction> mean;
   if (options.prior == "rff" && incremental.every == 0 &&
@@ -679,7 +679,7 @@ bool RunSlam(const Dataset& dataset, const SlamOptions& options,
     }
     if (wnoa_mean) {
       mean = std::make_shared<PiecewiseLinearMean>(wnoa.trajectory);
-      mean_covariance = std::move(wnoa);
+      wnoa_mean_solve = std::move(wnoa);
     } else {
       warm.initial_poses = wnoa.trajectory;
       for (const Landmark& l : wnoa.landmarks) {
@@ -818,7 +818,7 @@ bool RunSlam(const Dataset& dataset, const SlamOptions& options,
     if (!ComputePosteriorCovariance(
             problem.get(), *model, times, covariance_options,
             &result->pose_covariances, &result->landmarks, error) ||
-        !AddMeanCovariance(mean_covariance, result, error)) {
+        !AddMeanCovariance(wnoa_mean_solve, result, error)) {
       return false;
     }
   }
