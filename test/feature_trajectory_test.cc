@@ -18,6 +18,17 @@ std::shared_ptr<const MeanFunction> ZeroMean() {
       std::vector<TimedPose>{{0.0, 0.0, 0.0, 0.0}});
 }
 
+// Options with the given kernels (x and y, theta) and feature counts.
+FeatureTrajectoryOptions Options(const KernelOptions& position,
+                                 const KernelOptions& heading, int features) {
+  FeatureTrajectoryOptions options;
+  options.position_kernel = position;
+  options.heading_kernel = heading;
+  options.num_position_features = features;
+  options.num_heading_features = features;
+  return options;
+}
+
 // Prior covariance of coordinate c at t and u under b ~ N(0, I): the sum of
 // phi_t . phi_u over the terms of the two maps that share a block.
 double PriorCovariance(const FeatureTrajectory& model, int c, double t,
@@ -37,11 +48,8 @@ double PriorCovariance(const FeatureTrajectory& model, int c, double t,
 // The weight-space prior is the kernel (paper eq. 4): with ample Hilbert
 // features on one global map, phi(t)^T phi(u) = k(t - u) for x, y and theta.
 TEST(FeatureTrajectoryTest, PriorCovarianceIsTheKernel) {
-  FeatureTrajectoryOptions options;
-  options.position_kernel = {"matern52", 4.0, 5.0};
-  options.heading_kernel = {"rbf", 0.3, 8.0};
-  options.num_position_features = 200;
-  options.num_heading_features = 200;
+  const FeatureTrajectoryOptions options =
+      Options({"matern52", 4.0, 5.0}, {"rbf", 0.3, 8.0}, 200);
   std::string error;
   const auto model =
       FeatureTrajectory::Create(options, ZeroMean(), 0.0, 60.0, &error);
@@ -66,11 +74,8 @@ TEST(FeatureTrajectoryTest, PriorCovarianceIsTheKernel) {
 // Windowed weights: the pose is continuous across the blends of segments
 // (random weights, the derivative bounded by the features' bandwidth).
 TEST(FeatureTrajectoryTest, SegmentsBlendContinuously) {
-  FeatureTrajectoryOptions options;
-  options.position_kernel = {"rbf", 4.0, 3.0};
-  options.heading_kernel = {"rbf", 0.3, 3.0};
-  options.num_position_features = 40;
-  options.num_heading_features = 40;
+  FeatureTrajectoryOptions options =
+      Options({"rbf", 4.0, 3.0}, {"rbf", 0.3, 3.0}, 40);
   options.segment_length = 20.0;
   options.segment_overlap = 8.0;
   std::string error;
@@ -96,11 +101,8 @@ TEST(FeatureTrajectoryTest, SegmentsBlendContinuously) {
 // about the same number of features (the same number of lengthscales to
 // cover at the same tolerance), whatever the lengthscale in seconds.
 TEST(FeatureTrajectoryTest, AutoCapacityFollowsTheLengthscale) {
-  FeatureTrajectoryOptions options;
-  options.num_position_features = kAutoCapacity;
-  options.num_heading_features = kAutoCapacity;
-  options.position_kernel = {"matern52", 25.0, 8.0};
-  options.heading_kernel = {"matern52", 0.25, 12.0};
+  FeatureTrajectoryOptions options =
+      Options({"matern52", 25.0, 8.0}, {"matern52", 0.25, 12.0}, kAutoCapacity);
   const FeatureTrajectoryOptions long_scale = AutoCapacity(options, 600.0);
   EXPECT_DOUBLE_EQ(long_scale.segment_length, 80.0);
   EXPECT_DOUBLE_EQ(long_scale.segment_overlap, 32.0);
