@@ -124,6 +124,10 @@ DEFINE_double(max_preintegration_seconds, 1.0,
               "Longest time one preintegrated odometry chain may span.");
 
 // Ceres.
+DEFINE_double(max_memory_gb, 0.0,
+              "Largest linear system a solve may form, in GB (0: half of the "
+              "machine's memory); a dense solver whose system is larger is "
+              "refused before the solve, naming the size.");
 DEFINE_string(linear_solver, "auto",
               "Ceres linear solver: auto (DENSE_SCHUR when at most 2000 "
               "trajectory parameters remain after eliminating the landmarks, "
@@ -227,6 +231,7 @@ SlamOptions SlamOptionsFromFlags() {
   s.gradient_tolerance = FLAGS_gradient_tolerance;
   s.parameter_tolerance = FLAGS_parameter_tolerance;
   s.log_progress = true;
+  s.max_memory_gb = FLAGS_max_memory_gb;
   return options;
 }
 

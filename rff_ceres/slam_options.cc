@@ -50,6 +50,12 @@ bool ValidateSlamOptions(const SlamOptions& options, std::string* error) {
     *error = "prior mean 'wnoa' is for the rff prior";
     return false;
   }
+  if (!(options.solver.max_memory_gb >= 0.0) ||
+      !std::isfinite(options.solver.max_memory_gb)) {
+    *error = "max_memory_gb must be finite and >= 0, got " +
+             FormatNumber(options.solver.max_memory_gb);
+    return false;
+  }
   if (options.outer_rounds < 0) {
     *error = "outer_rounds must be >= 0, got " +
              std::to_string(options.outer_rounds);

@@ -11,6 +11,7 @@
 #include "rff_ceres/initialization.h"
 #include "rff_ceres/io/text_parser.h"
 #include "rff_ceres/landmark_init.h"
+#include "rff_ceres/linear_system_size.h"
 #include "rff_ceres/mean/prior_mean.h"
 #include "rff_ceres/mean/spline_mean.h"
 #include "rff_ceres/mean_rotation.h"
@@ -301,6 +302,11 @@ bool SolveBatch(const Dataset& dataset, const SlamOptions& options,
     if (!(*problem)->Build(dataset, *landmarks, error)) return false;
     ChooseLinearSolver(options.solver, *model, &ceres_options, result);
     SetOrdering(problem->get(), &ceres_options);
+    if (!CheckLinearSystemFits(problem->get(), ceres_options,
+                               MemoryLimitBytes(options.solver.max_memory_gb),
+                               error)) {
+      return false;
+    }
     ceres::Solve(ceres_options, (*problem)->problem(), &result->summary);
     VLOG(1) << result->summary.FullReport();
     if (!CheckSolve(result->summary, problem->get(), error)) return false;
@@ -443,6 +449,11 @@ bool SolveIncremental(const Dataset& dataset, const SlamOptions& options,
     }
     // The preprocessor edits the ordering it is given: a fresh one per solve.
     SetOrdering(&slam, &ceres_options);
+    if (!CheckLinearSystemFits(&slam, ceres_options,
+                               MemoryLimitBytes(options.solver.max_memory_gb),
+                               error)) {
+      return false;
+    }
     ceres::Solve(ceres_options, ceres_problem, &result->summary);
     if (!CheckSolve(result->summary, &slam, error)) {
       *error = "update at t = " + FormatNumber(now) + ": " + *error;

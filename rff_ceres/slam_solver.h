@@ -38,6 +38,9 @@ struct SolverOptions {
   double gradient_tolerance = 1e-10;
   double parameter_tolerance = 1e-8;
   bool log_progress = false;  // Ceres's per-iteration log (glog INFO).
+  // Largest linear system a solve may form (GB; 0: half of the machine's
+  // memory): a larger one is refused before it is allocated.
+  double max_memory_gb = 0.0;
 };
 
 // Validates `options` and fills the Ceres options from it.

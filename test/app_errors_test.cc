@@ -231,6 +231,8 @@ const AppCase kAppCases[] = {
      "prior_mean must be auto, odometry, wnoa, localization, spline or "
      "constant, got 'psychic'",
      "{dir}/out.tum"},
+    {"SlamNegativeMemoryLimit", SLAM "--max_memory_gb=-1" SLAM_OUT,
+     "max_memory_gb must be finite and >= 0, got -1", "{dir}/out.tum"},
     // Options are checked before the dataset is read.
     {"SlamBadOptionBeforeMissingDataset",
      "{bin}/rff_slam --dataset={dir}/missing.rffd --prior=brownian" SLAM_OUT,

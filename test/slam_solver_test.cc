@@ -1,9 +1,11 @@
 #include "rff_ceres/slam_solver.h"
 
 #include <algorithm>
+#include <map>
 
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
+#include "rff_ceres/linear_system_size.h"
 #include "rff_ceres/mean/prior_mean.h"
 #include "rff_ceres/metrics.h"
 #include "rff_ceres/simulate.h"
@@ -423,6 +425,61 @@ TEST(SlamProblemTest, LandmarkSeenByOneRangeIsNotDetermined) {
   ASSERT_TRUE(problem.Build(dataset, landmarks, &error)) << error;
   EXPECT_FALSE(problem.CheckLandmarksDetermined(1e12, &error));
   EXPECT_THAT(error, HasSubstr("landmark 99 is not determined"));
+}
+
+// A dense solver whose system would not fit is refused before the solve,
+// naming the solver, the size and the limit; auto picks the sparse
+// factorisation for the same banded WNOA problem and solves it.
+TEST(LinearSystemSizeTest, TooLargeDenseSystemIsRefusedAndAutoSolves) {
+  SimulationOptions sim = PaperOptions(5);
+  sim.num_steps = 200;
+  Dataset dataset;
+  std::string error;
+  ASSERT_TRUE(Simulate(sim, &dataset, &error)) << error;
+  SlamOptions options;
+  options.prior = "wnoa";
+  options.solver.linear_solver = "DENSE_SCHUR";
+  options.solver.max_memory_gb = 0.001;
+  SlamResult result;
+  EXPECT_FALSE(RunSlam(dataset, options, &result, &error));
+  EXPECT_THAT(error, HasSubstr("linear solver DENSE_SCHUR needs about"));
+  EXPECT_THAT(error, HasSubstr("reduced system, more than the 0.001 GB "
+                               "allowed (--max_memory_gb)"));
+  EXPECT_EQ(result.total_iterations, 0);
+  options.solver.linear_solver = "auto";
+  ASSERT_TRUE(RunSlam(dataset, options, &result, &error)) << error;
+  EXPECT_EQ(result.linear_solver, "SPARSE_NORMAL_CHOLESKY");
+}
+
+TEST(LinearSystemSizeTest, DenseSchurIsTwoCopiesOfTheReducedSystem) {
+  SimulationOptions sim = PaperOptions(6);
+  sim.num_steps = 30;
+  Dataset dataset;
+  std::string error;
+  ASSERT_TRUE(Simulate(sim, &dataset, &error)) << error;
+  SlamOptions options;
+  options.trajectory.num_position_features = 10;
+  options.trajectory.num_heading_features = 10;
+  const auto mean = BuildPriorMean("odometry", dataset, &error);
+  ASSERT_TRUE(mean) << error;
+  options.prior_mean = "odometry";
+  const auto model = CreateTrajectoryModel(dataset, options, mean, &error);
+  ASSERT_TRUE(model) << error;
+  std::map<LandmarkId, Eigen::Vector2d> landmarks;
+  for (const LandmarkPrior& p : dataset.landmark_priors) {
+    landmarks[p.id] = Eigen::Vector2d(p.x, p.y);
+  }
+  SlamProblem problem(model.get(), options.problem);
+  ASSERT_TRUE(problem.Build(dataset, landmarks, &error)) << error;
+  const long long t = problem.problem()->NumParameters() -
+                      2 * static_cast<long long>(landmarks.size());
+  const LinearSystemSize size =
+      EstimateLinearSystemSize(&problem, ceres::DENSE_SCHUR);
+  EXPECT_EQ(size.rows, t);
+  EXPECT_DOUBLE_EQ(size.bytes, 16.0 * t * t);
+  EXPECT_EQ(
+      EstimateLinearSystemSize(&problem, ceres::SPARSE_NORMAL_CHOLESKY).bytes,
+      0.0);
 }
 
 }  // namespace

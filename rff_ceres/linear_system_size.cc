@@ -1,0 +1,99 @@
+#include "rff_ceres/linear_system_size.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <map>
+#include <set>
+#include <vector>
+
+#include "ceres/problem.h"
+#include "ceres/types.h"
+
+namespace rff {
+
+LinearSystemSize EstimateLinearSystemSize(SlamProblem* problem,
+                                          ceres::LinearSolverType type) {
+  ceres::Problem* ceres_problem = problem->problem();
+  std::set<const double*> landmark_blocks;
+  for (const auto& [id, position] : problem->landmarks()) {
+    landmark_blocks.insert(problem->landmark_block(id));
+  }
+  const long long n = ceres_problem->NumParameters();
+  const long long t = n - 2 * static_cast<long long>(landmark_blocks.size());
+  const long long m = ceres_problem->NumResiduals();
+  LinearSystemSize size;
+  switch (type) {
+    // Doubles, and a second copy where the dense factorisation takes one.
+    case ceres::DENSE_QR:
+      size = {8.0 * m * n, m, n, "Jacobian"};
+      break;
+    case ceres::DENSE_NORMAL_CHOLESKY:
+      size = {2.0 * 8.0 * n * n, n, n, "normal equations"};
+      break;
+    case ceres::DENSE_SCHUR:
+      size = {2.0 * 8.0 * t * t, t, t, "reduced system"};
+      break;
+    case ceres::SPARSE_SCHUR: {
+      // The trajectory blocks each landmark sees become one dense clique of
+      // the reduced system.
+      std::map<const double*, std::set<double*>> seen;
+      std::vector<ceres::ResidualBlockId> residuals;
+      ceres_problem->GetResidualBlocks(&residuals);
+      std::vector<double*> blocks;
+      for (const ceres::ResidualBlockId id : residuals) {
+        ceres_problem->GetParameterBlocksForResidualBlock(id, &blocks);
+        const auto landmark = std::find_if(
+            blocks.begin(), blocks.end(),
+            [&](double* b) { return landmark_blocks.count(b) > 0; });
+        if (landmark == blocks.end()) continue;
+        for (double* b : blocks) {
+          if (b != *landmark) seen[*landmark].insert(b);
+        }
+      }
+      double entries = 0.0;
+      for (const auto& [landmark, trajectory] : seen) {
+        double clique = 0.0;
+        for (double* b : trajectory) {
+          clique += ceres_problem->ParameterBlockSize(b);
+        }
+        entries += clique * clique;
+      }
+      entries = std::min(entries, static_cast<double>(t) * t);
+      size = {8.0 * entries, t, t, "reduced system"};
+      break;
+    }
+    default:
+      break;
+  }
+  return size;
+}
+
+double MemoryLimitBytes(double max_memory_gb) {
+  if (max_memory_gb > 0.0) return max_memory_gb * 1e9;
+  const long pages = sysconf(_SC_PHYS_PAGES);
+  const long page_size = sysconf(_SC_PAGE_SIZE);
+  return 0.5 * static_cast<double>(pages) * static_cast<double>(page_size);
+}
+
+bool CheckLinearSystemFits(SlamProblem* problem,
+                           const ceres::Solver::Options& options,
+                           double limit_bytes, std::string* error) {
+  const LinearSystemSize size =
+      EstimateLinearSystemSize(problem, options.linear_solver_type);
+  if (size.bytes <= limit_bytes) return true;
+  char buffer[400];
+  std::snprintf(
+      buffer, sizeof(buffer),
+      "linear solver %s needs about %.3g GB for its %lld x %lld %s, more "
+      "than the %.3g GB allowed (--max_memory_gb); --linear_solver=auto picks "
+      "a sparse factorisation where the system is banded",
+      ceres::LinearSolverTypeToString(options.linear_solver_type),
+      size.bytes / 1e9, size.rows, size.cols, size.what.c_str(),
+      limit_bytes / 1e9);
+  *error = buffer;
+  return false;
+}
+
+}  // namespace rff
