@@ -141,9 +141,9 @@ bool LearnHyperparameters(
 
   FeatureTrajectoryOptions start_values = *trajectory;
   MatchVariancesToSpread(*mean, window_initial, &start_values);
-  // The evidence of one candidate; -inf where a kernel cannot be built.
-  auto evidence = [&](const LogParameters& p) {
-    ++report->evaluations;
+  // The evidence of one candidate (and the data's level there); -inf where
+  // a kernel cannot be built.
+  auto log_evidence = [&](const LogParameters& p, Eigen::Vector3d* level) {
     FeatureTrajectoryOptions candidate = *trajectory;
     FromLog(p, &candidate);
     std::string why;
@@ -152,7 +152,12 @@ bool LearnHyperparameters(
     const std::unique_ptr<Kernel> heading =
         CreateKernel(candidate.heading_kernel, &why);
     if (!position || !heading) return -std::numeric_limits<double>::infinity();
-    const double value = PoseLogEvidence(likelihood, *position, *heading);
+    return PoseLogEvidence(likelihood, *position, *heading, level);
+  };
+  // The same, counted and logged: one step of the search.
+  auto evidence = [&](const LogParameters& p) {
+    ++report->evaluations;
+    const double value = log_evidence(p, nullptr);
     VLOG(2) << "evidence at lengthscale " << std::exp(p[0]) << ", variance "
             << std::exp(p[1]) << ", heading lengthscale " << std::exp(p[2])
             << ", variance " << std::exp(p[3]) << ": " << value;
@@ -210,14 +215,9 @@ bool LearnHyperparameters(
                         [&](double v) { return clamp(kernel, v); });
     }
   }
+  log_evidence(best, &report->level);
   FromLog(best, trajectory);
   report->log_evidence = best_value;
-  std::string why;
-  const std::unique_ptr<Kernel> position =
-      CreateKernel(trajectory->position_kernel, &why);
-  const std::unique_ptr<Kernel> heading =
-      CreateKernel(trajectory->heading_kernel, &why);
-  PoseLogEvidence(likelihood, *position, *heading, &report->level);
   report->seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
           .count();

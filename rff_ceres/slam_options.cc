@@ -22,14 +22,8 @@ bool CheckOneOf(const std::string& value, const char* name,
   if (std::find(allowed.begin(), allowed.end(), value) != allowed.end()) {
     return true;
   }
-  std::string list;
-  for (std::size_t i = 0; i < allowed.size(); ++i) {
-    list += (i == 0                    ? ""
-             : i + 1 == allowed.size() ? " or "
-                                       : ", ") +
-            allowed[i];
-  }
-  *error = std::string(name) + " must be " + list + ", got '" + value + "'";
+  *error = std::string(name) + " must be " + JoinAlternatives(allowed) +
+           ", got '" + value + "'";
   return false;
 }
 

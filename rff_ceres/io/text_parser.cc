@@ -159,6 +159,14 @@ std::string JsonString(const std::string& text) {
   return out + "\"";
 }
 
+std::string JoinAlternatives(const std::vector<std::string>& names) {
+  std::string joined;
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    joined += (i == 0 ? "" : i + 1 == names.size() ? " or " : ", ") + names[i];
+  }
+  return joined;
+}
+
 bool OpenForReading(const std::string& path, std::ifstream* stream,
                     std::string* error) {
   stream->open(path, std::ios::in | std::ios::binary);

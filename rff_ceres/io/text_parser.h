@@ -93,6 +93,9 @@ bool OpenForWriting(const std::string& path, std::ofstream* stream,
 bool FinishWriting(const std::string& path, std::ofstream* stream,
                    std::string* error);
 
+// "a", "a or b", "a, b or c": the allowed values of an option, for messages.
+std::string JoinAlternatives(const std::vector<std::string>& names);
+
 // Option checks (converters, trajectory models): `value` must be finite and
 // > 0 (>= 0); otherwise `error` names the option and the value.
 inline bool CheckPositiveOption(double value, const char* name,

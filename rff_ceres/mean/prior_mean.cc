@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "rff_ceres/dead_reckoning.h"
+#include "rff_ceres/io/text_parser.h"
 #include "rff_ceres/mean/localization_mean.h"
 #include "rff_ceres/mean/spline_mean.h"
 
@@ -11,19 +12,6 @@ namespace rff {
 std::vector<std::string> PriorMeanNames() {
   return {"auto", "odometry", "wnoa", "localization", "spline", "constant"};
 }
-
-namespace {
-
-std::string NameList() {
-  std::string list;
-  const std::vector<std::string> names = PriorMeanNames();
-  for (std::size_t i = 0; i < names.size(); ++i) {
-    list += (i == 0 ? "" : i + 1 == names.size() ? " or " : ", ") + names[i];
-  }
-  return list;
-}
-
-}  // namespace
 
 std::shared_ptr<const MeanFunction> BuildPriorMean(const std::string& name,
                                                    const Dataset& dataset,
@@ -38,7 +26,8 @@ std::shared_ptr<const MeanFunction> BuildPriorMean(
     std::string* error) {
   const std::vector<std::string> names = PriorMeanNames();
   if (std::find(names.begin(), names.end(), name) == names.end()) {
-    *error = "unknown prior mean '" + name + "' (expected " + NameList() + ")";
+    *error = "unknown prior mean '" + name + "' (expected " +
+             JoinAlternatives(PriorMeanNames()) + ")";
     return nullptr;
   }
   // Checked whatever the name: "auto" and "spline" may localise.
