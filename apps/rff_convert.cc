@@ -13,7 +13,9 @@
 #include "rff_ceres/convert/mrclam.h"
 #include "rff_ceres/convert/plaza.h"
 #include "rff_ceres/io/dataset_io.h"
+#include "rff_ceres/io/output_file.h"
 #include "rff_ceres/io/text_parser.h"
+#include "tool_flags.h"
 
 DEFINE_string(format, "", "Raw layout of --input: plaza or mrclam");
 DEFINE_string(input, "", "Directory with the raw dataset files");
@@ -123,7 +125,7 @@ bool ConvertPlaza(rff::Dataset* dataset, std::string* error) {
     options.heading_offset = offset;
   }
   options.heading_offset_tolerance = FLAGS_plaza_heading_offset_tolerance;
-  if (FLAGS_prior_sigma_xy >= 0.0) {
+  if (FLAGS_prior_sigma_xy != -1.0) {  // -1: the format's default.
     options.first_pose_sigma_xy = FLAGS_prior_sigma_xy;
   }
   options.first_pose_sigma_theta = FLAGS_prior_sigma_theta;
@@ -165,7 +167,7 @@ bool ConvertMrclam(rff::Dataset* dataset, std::string* error) {
   options.odometry_sigma_theta_floor = FLAGS_mrclam_odom_sigma_theta_floor;
   options.odometry_sigma_theta_per_second = FLAGS_mrclam_odom_sigma_theta_per_s;
   options.landmark_prior_sigma = FLAGS_mrclam_landmark_prior_sigma;
-  if (FLAGS_prior_sigma_xy >= 0.0) {
+  if (FLAGS_prior_sigma_xy != -1.0) {  // -1: the format's default.
     options.first_pose_sigma_xy = FLAGS_prior_sigma_xy;
   }
   options.first_pose_sigma_theta = FLAGS_prior_sigma_theta;
@@ -202,13 +204,15 @@ int main(int argc, char** argv) {
       "[--plaza_calibration=linear|none]\n"
       "  rff_convert --format=mrclam --input=DIR --mrclam_robot=N "
       "--output=OUT.rffd [--mrclam_odometry_interval=SECONDS]");
-  gflags::ParseCommandLineFlags(&argc, &argv, true);
-  if (argc > 1)
-    return Fail(std::string("unexpected argument '") + argv[1] + "'");
+  std::string error;
+  if (!rff::ParseToolFlags(&argc, &argv, &error)) return Fail(error);
   if (FLAGS_input.empty()) return Fail("--input=DIR is required");
   if (FLAGS_output.empty()) return Fail("--output=OUT.rffd is required");
+  if (!rff::CheckOutputPaths({{"--input", FLAGS_input}},
+                             {{"--output", FLAGS_output}}, &error)) {
+    return Fail(error);
+  }
   rff::Dataset dataset;
-  std::string error;
   bool ok;
   if (FLAGS_format == "plaza") {
     ok = ConvertPlaza(&dataset, &error);

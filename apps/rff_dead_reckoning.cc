@@ -10,8 +10,10 @@
 #include "gflags/gflags.h"
 #include "rff_ceres/dead_reckoning.h"
 #include "rff_ceres/io/dataset_io.h"
+#include "rff_ceres/io/output_file.h"
 #include "rff_ceres/io/text_parser.h"
 #include "rff_ceres/io/tum_io.h"
+#include "tool_flags.h"
 
 DEFINE_string(dataset, "", "Dataset (.rffd) with PRIOR_POSE and ODOM records.");
 DEFINE_string(output_trajectory, "", "Where to write the trajectory (TUM).");
@@ -32,15 +34,18 @@ int main(int argc, char** argv) {
   gflags::SetUsageMessage(
       "rff_dead_reckoning --dataset=IN.rffd --output_trajectory=OUT.tum "
       "[--hold_through_gaps]");
-  gflags::ParseCommandLineFlags(&argc, &argv, true);
-  if (argc > 1)
-    return Fail(std::string("unexpected argument '") + argv[1] + "'");
+  std::string error;
+  if (!rff::ParseToolFlags(&argc, &argv, &error)) return Fail(error);
   if (FLAGS_dataset.empty()) return Fail("--dataset is required");
   if (FLAGS_output_trajectory.empty()) {
     return Fail("--output_trajectory is required");
   }
+  if (!rff::CheckOutputPaths({{"--dataset", FLAGS_dataset}},
+                             {{"--output_trajectory", FLAGS_output_trajectory}},
+                             &error)) {
+    return Fail(error);
+  }
 
-  std::string error;
   rff::Dataset dataset;
   if (!rff::ReadDataset(FLAGS_dataset, &dataset, &error)) return Fail(error);
   rff::DeadReckoningOptions options;

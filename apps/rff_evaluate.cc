@@ -12,8 +12,10 @@
 #include "rff_ceres/consistency.h"
 #include "rff_ceres/io/dataset_io.h"
 #include "rff_ceres/io/landmarks_io.h"
+#include "rff_ceres/io/output_file.h"
 #include "rff_ceres/io/tum_io.h"
 #include "rff_ceres/metrics.h"
+#include "tool_flags.h"
 
 DEFINE_string(dataset, "", "Dataset (.rffd) with GT_POSE (and GT_LANDMARK).");
 DEFINE_string(trajectory, "", "Estimated trajectory (TUM).");
@@ -42,13 +44,18 @@ int main(int argc, char** argv) {
       "rff_evaluate --dataset=IN.rffd --trajectory=EST.tum "
       "[--landmarks=EST.landmarks] [--covariance=EST.cov] [--align] "
       "[--json=OUT.json]");
-  gflags::ParseCommandLineFlags(&argc, &argv, true);
-  if (argc > 1)
-    return Fail(std::string("unexpected argument '") + argv[1] + "'");
+  std::string error;
+  if (!rff::ParseToolFlags(&argc, &argv, &error)) return Fail(error);
   if (FLAGS_dataset.empty()) return Fail("--dataset is required");
   if (FLAGS_trajectory.empty()) return Fail("--trajectory is required");
+  if (!rff::CheckOutputPaths({{"--dataset", FLAGS_dataset},
+                              {"--trajectory", FLAGS_trajectory},
+                              {"--landmarks", FLAGS_landmarks},
+                              {"--covariance", FLAGS_covariance}},
+                             {{"--json", FLAGS_json}}, &error)) {
+    return Fail(error);
+  }
 
-  std::string error;
   rff::Dataset dataset;
   if (!rff::ReadDataset(FLAGS_dataset, &dataset, &error)) return Fail(error);
   if (dataset.ground_truth.empty()) {

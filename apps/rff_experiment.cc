@@ -22,7 +22,9 @@
 #include "gflags/gflags.h"
 #include "glog/logging.h"
 #include "rff_ceres/experiment/experiment.h"
+#include "rff_ceres/io/flagfile_check.h"
 #include "slam_flags.h"
+#include "tool_flags.h"
 
 DEFINE_string(out_dir, "", "Directory for the tables and plots (created).");
 DEFINE_bool(quick, false,
@@ -106,11 +108,9 @@ int main(int argc, char** argv) {
   gflags::SetUsageMessage(
       "rff_experiment --out_dir=DIR [--quick] [--methods=rff,wnoa] "
       "[--experiments=table1,figure1,table2,figure2,solvers]");
-  gflags::ParseCommandLineFlags(&argc, &argv, true);
+  std::string error;
+  if (!rff::ParseToolFlags(&argc, &argv, &error)) return Fail(error);
   google::InitGoogleLogging(argv[0]);
-  if (argc > 1) {
-    return Fail(std::string("unexpected argument '") + argv[1] + "'");
-  }
   if (FLAGS_out_dir.empty()) return Fail("--out_dir is required");
 
   const std::string root = FindSourceRoot(argv[0]);
@@ -129,7 +129,6 @@ int main(int argc, char** argv) {
   if (shared_dir.empty() && !root.empty()) shared_dir = root + "/../shared";
 
   rff::ExperimentConfig config;
-  std::string error;
   if (!rff::ParseMethods(FLAGS_methods, &config.methods, &error)) {
     return Fail("--methods: " + error);
   }
@@ -165,6 +164,10 @@ int main(int argc, char** argv) {
     }
     // Every flagfile starts from the command line's flags; the saver puts
     // them back afterwards. Not fatal: a bad file is a failed row.
+    if (!rff::CheckFlagfiles({"--flagfile=" + path}, rff::IsKnownToolFlag,
+                             message)) {
+      return false;
+    }
     gflags::FlagSaver saver;
     if (!gflags::ReadFromFlagsFile(path, program, false)) {
       *message = path +

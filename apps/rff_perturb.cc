@@ -12,7 +12,9 @@
 #include <cstdio>
 #include <string>
 
+#include "rff_ceres/io/output_file.h"
 #include "rff_ceres/perturb.h"
+#include "tool_flags.h"
 
 DEFINE_string(input, "", "Input .rffd path (required).");
 DEFINE_string(output, "", "Output .rffd path (required; not the input file).");
@@ -41,11 +43,14 @@ int main(int argc, char** argv) {
       "rff_perturb --input=IN.rffd --output=OUT.rffd "
       "[--landmark_prior_offset=M] [--start_heading_offset_deg=D] "
       "[--start_heading_sigma=RAD] [--seed=1]");
-  gflags::ParseCommandLineFlags(&argc, &argv, /*remove_flags=*/true);
-  if (argc > 1)
-    return Fail(std::string("unexpected argument '") + argv[1] + "'");
+  std::string error;
+  if (!rff::ParseToolFlags(&argc, &argv, &error)) return Fail(error);
   if (FLAGS_input.empty()) return Fail("--input is required");
   if (FLAGS_output.empty()) return Fail("--output is required");
+  if (!rff::CheckOutputPaths({{"--input", FLAGS_input}},
+                             {{"--output", FLAGS_output}}, &error)) {
+    return Fail(error);
+  }
 
   rff::PerturbOptions options;
   options.landmark_prior_offset = FLAGS_landmark_prior_offset;
@@ -55,7 +60,6 @@ int main(int argc, char** argv) {
     options.start_heading_sigma = FLAGS_start_heading_sigma;
   }
   options.seed = FLAGS_seed;
-  std::string error;
   if (!rff::PerturbFile(FLAGS_input, FLAGS_output, options, &error)) {
     return Fail(error);
   }

@@ -15,10 +15,12 @@
 #include <string>
 
 #include "rff_ceres/io/dataset_io.h"
+#include "rff_ceres/io/output_file.h"
 #include "rff_ceres/io/text_parser.h"
 #include "rff_ceres/simulate.h"
 #include "rff_ceres/simulate_gp_draw.h"
 #include "rff_ceres/types.h"
+#include "tool_flags.h"
 
 DEFINE_string(output, "", "Output .rffd path (required).");
 DEFINE_string(preset, "paper",
@@ -92,10 +94,12 @@ int main(int argc, char** argv) {
       "rff_simulate --output=OUT.rffd "
       "[--preset=paper|kitti_scale|laser_10hz|gp_draw] "
       "[--seed=1] [--kind=range_bearing] [--landmarks=50] ...");
-  gflags::ParseCommandLineFlags(&argc, &argv, /*remove_flags=*/true);
-  if (argc > 1)
-    return Fail(std::string("unexpected argument '") + argv[1] + "'");
+  std::string error;
+  if (!rff::ParseToolFlags(&argc, &argv, &error)) return Fail(error);
   if (FLAGS_output.empty()) return Fail("--output is required");
+  if (!rff::CheckOutputPaths({}, {{"--output", FLAGS_output}}, &error)) {
+    return Fail(error);
+  }
 
   rff::SimulationOptions options;
   if (FLAGS_preset == "paper") {
@@ -119,7 +123,6 @@ int main(int argc, char** argv) {
   if (all || Given("speed")) options.speed = FLAGS_speed;
   if (all || Given("landmarks")) options.num_landmarks = FLAGS_landmarks;
   if (all || Given("kind")) {
-    std::string error;
     if (!rff::ParseMeasurementKind(FLAGS_kind, &options.kind, &error)) {
       return Fail("--kind: " + error);
     }
@@ -190,7 +193,6 @@ int main(int argc, char** argv) {
   }
 
   rff::Dataset dataset;
-  std::string error;
   if (!rff::Simulate(options, &dataset, &error)) return Fail(error);
   if (!rff::WriteDataset(dataset, FLAGS_output, &error)) return Fail(error);
   std::printf(

@@ -14,13 +14,12 @@
 #include "glog/logging.h"
 #include "rff_ceres/features/feature_map.h"
 #include "rff_ceres/io/dataset_io.h"
-#include "rff_ceres/io/landmarks_io.h"
-#include "rff_ceres/io/pose_covariance_io.h"
-#include "rff_ceres/io/tum_io.h"
+#include "rff_ceres/io/output_file.h"
 #include "rff_ceres/metrics.h"
 #include "rff_ceres/slam_report.h"
 #include "rff_ceres/slam_solver.h"
 #include "slam_flags.h"
+#include "tool_flags.h"
 
 DEFINE_string(dataset, "", "Input dataset (.rffd).");
 DEFINE_string(output_trajectory, "", "Write the trajectory here (TUM).");
@@ -51,17 +50,25 @@ int main(int argc, char** argv) {
       "rff_slam --dataset=IN.rffd --output_trajectory=OUT.tum "
       "--output_landmarks=OUT.landmarks [--summary_json=OUT.json] "
       "[--flagfile=configs/NAME.flags]");
-  gflags::ParseCommandLineFlags(&argc, &argv, true);
+  std::string error;
+  if (!rff::ParseToolFlags(&argc, &argv, &error)) return Fail(error);
   google::InitGoogleLogging(argv[0]);
-  if (argc > 1) {
-    return Fail(std::string("unexpected argument '") + argv[1] + "'");
-  }
   if (FLAGS_dataset.empty()) return Fail("--dataset is required");
 
-  std::string error;
   rff::SlamOptions options = rff::SlamOptionsFromFlags();
   options.compute_covariance = !FLAGS_output_covariance.empty();
   if (!rff::ValidateSlamOptions(options, &error)) return Fail(error);
+  const rff::SlamOutputPaths outputs = {
+      FLAGS_output_trajectory, FLAGS_output_landmarks, FLAGS_output_covariance,
+      FLAGS_summary_json};
+  if (!rff::CheckOutputPaths({{"--dataset", FLAGS_dataset}},
+                             {{"--output_trajectory", outputs.trajectory},
+                              {"--output_landmarks", outputs.landmarks},
+                              {"--output_covariance", outputs.covariance},
+                              {"--summary_json", outputs.summary_json}},
+                             &error)) {
+    return Fail(error);
+  }
   rff::Dataset dataset;
   if (!rff::ReadDataset(FLAGS_dataset, &dataset, &error)) return Fail(error);
   rff::SlamResult result;
@@ -72,21 +79,7 @@ int main(int argc, char** argv) {
   std::cout << "rff_slam: " << FLAGS_dataset << "\n";
   rff::PrintSlamSummary(options, result, &std::cout);
 
-  if (!FLAGS_output_trajectory.empty() &&
-      !rff::WriteTum(result.trajectory, FLAGS_output_trajectory, &error)) {
-    return Fail(error);
-  }
-  if (!FLAGS_output_landmarks.empty() &&
-      !rff::WriteLandmarks(result.landmarks, FLAGS_output_landmarks, &error)) {
-    return Fail(error);
-  }
-  if (!FLAGS_output_covariance.empty() &&
-      !rff::WritePoseCovariances(result.trajectory, result.pose_covariances,
-                                 FLAGS_output_covariance, &error)) {
-    return Fail(error);
-  }
-  if (!FLAGS_summary_json.empty() &&
-      !rff::WriteSummaryJson(options, result, FLAGS_summary_json, &error)) {
+  if (!rff::WriteSlamOutputs(options, result, outputs, &error)) {
     return Fail(error);
   }
   if (FLAGS_evaluate && !dataset.ground_truth.empty()) {

@@ -47,8 +47,9 @@ DEFINE_int32(num_features, 0,
              "Features per coordinate of x and y (D) per segment; 0 (auto): "
              "D, the segment length and the overlap follow the lengthscales "
              "so that the motion the basis misses stays below 5 cm and "
-             "0.005 rad.");
-DEFINE_int32(num_heading_features, 0, "Features of theta (0: --num_features).");
+             "0.005 rad. At most 2048.");
+DEFINE_int32(num_heading_features, 0,
+             "Features of theta (0: --num_features). At most 2048.");
 DEFINE_string(learn_hyperparameters, "auto",
               "Learn the prior's hyperparameters from the data: on, off or "
               "auto. RFF: lengthscales and variances of x, y and theta by the "
@@ -62,7 +63,7 @@ DEFINE_string(learn_hyperparameters, "auto",
 DEFINE_uint64(seed, 1, "Seed of the random feature frequencies.");
 DEFINE_double(segment_length, 0.0,
               "Windowed weights: segment length in seconds (0: one global "
-              "feature map over the whole run).");
+              "feature map over the whole run). At most 100000 segments.");
 DEFINE_double(segment_overlap, 0.0,
               "Windowed weights: blend overlap between segments (seconds).");
 
@@ -96,7 +97,7 @@ DEFINE_double(incremental_lag, 0.0,
 
 DEFINE_int32(outer_rounds, 0,
              "Smoothing-spline prior rounds (paper III-B.2): refit the mean "
-             "to the estimate and re-solve this many times.");
+             "to the estimate and re-solve this many times (at most 100).");
 DEFINE_double(spline_smoothing, 0.98,
               "Smoothing parameter p of the spline mean (De Boor).");
 

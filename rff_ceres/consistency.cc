@@ -101,6 +101,13 @@ bool EvaluateConsistency(const std::vector<TimedPose>& ground_truth,
     summary.position_coverage[k] /= n;
     summary.heading_coverage[k] /= n;
   }
+  if (!std::isfinite(summary.mean_position_nees) ||
+      !std::isfinite(summary.mean_heading_nees)) {
+    *error =
+        "the NEES overflows double precision: the errors are too large for "
+        "the covariances";
+    return false;
+  }
   summary.evaluated = true;
   return true;
 }

@@ -156,7 +156,18 @@ bool DeadReckon(const Dataset& dataset, const DeadReckoningOptions& options,
   for (const TimedPose& p : dataset.ground_truth) add_if_inside(p.t);
   std::sort(times.begin(), times.end());
   times.erase(std::unique(times.begin(), times.end()), times.end());
-  return InterpolateTrajectory(nodes, times, &result->poses, error);
+  if (!InterpolateTrajectory(nodes, times, &result->poses, error)) {
+    return false;
+  }
+  for (const TimedPose& p : result->poses) {
+    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.theta)) {
+      *error = "the integrated pose at t = " + FormatNumber(p.t) +
+               " overflows double precision (the ODOM motions sum beyond "
+               "1e308 m)";
+      return false;
+    }
+  }
+  return true;
 }
 
 }  // namespace rff

@@ -2,9 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
+#include <utility>
 
 #include "costs/weight_prior_cost.h"
 #include "rff_ceres/features/hilbert_features.h"
+#include "rff_ceres/io/text_parser.h"
 
 namespace rff {
 
@@ -71,20 +74,61 @@ std::unique_ptr<FeatureTrajectory> FeatureTrajectory::Create(
     const FeatureTrajectoryOptions& requested,
     std::shared_ptr<const MeanFunction> mean, double t_begin, double t_end,
     std::string* error) {
-  const FeatureTrajectoryOptions options =
-      AutoCapacity(requested, std::max(t_end - t_begin, 1e-3));
-  if (!(options.segment_length >= 0.0) || !(options.segment_overlap >= 0.0) ||
-      (options.segment_length > 0.0 &&
-       !(options.segment_overlap < options.segment_length))) {
+  for (const auto& [d, name] :
+       {std::pair(requested.num_position_features, "num_features"),
+        std::pair(requested.num_heading_features, "num_heading_features")}) {
+    if (d < 0 || d > kMaxFeatures) {
+      *error = std::string(name) + " must be in [0, " +
+               std::to_string(kMaxFeatures) +
+               "] (0: from the capacity rule), got " + std::to_string(d);
+      return nullptr;
+    }
+  }
+  if (requested.num_position_features == kAutoCapacity &&
+      requested.num_heading_features != kAutoCapacity) {
+    *error = "num_heading_features " +
+             std::to_string(requested.num_heading_features) +
+             " needs num_features > 0 (num_features 0 derives both from the "
+             "capacity rule)";
+    return nullptr;
+  }
+  if (!(requested.segment_length >= 0.0) ||
+      !(requested.segment_overlap >= 0.0) ||
+      !std::isfinite(requested.segment_length) ||
+      (requested.segment_length > 0.0 &&
+       !(requested.segment_overlap < requested.segment_length))) {
     *error = "segment length and overlap must be >= 0, with overlap < length";
+    return nullptr;
+  }
+  // A run with one time still needs a window of positive length.
+  const double length = std::max(t_end - t_begin, 1e-3);
+  if (requested.segment_length > 0.0 &&
+      !(length / requested.segment_length <= kMaxSegments)) {
+    *error = "segment_length " + FormatNumber(requested.segment_length) +
+             " s cuts the run's " + FormatNumber(length) +
+             " s into more than " + std::to_string(kMaxSegments) +
+             " segments; give a longer one";
+    return nullptr;
+  }
+  const FeatureTrajectoryOptions options = AutoCapacity(requested, length);
+  const double num_segments_needed =
+      options.segment_length > 0.0
+          ? std::ceil(length / options.segment_length - 1e-9)
+          : 1.0;
+  const double dp = options.num_position_features;
+  const double dh = options.num_heading_features;
+  if (num_segments_needed * (2.0 * dp * dp + dh * dh) > kMaxPriorNonZeros) {
+    *error = "the run's " + FormatNumber(length) + " s need " +
+             FormatNumber(num_segments_needed) + " segments of " +
+             FormatNumber(dp) + " features (x, y) and " + FormatNumber(dh) +
+             " (theta): more weights than memory allows; give fewer "
+             "features or longer segments";
     return nullptr;
   }
   std::unique_ptr<FeatureTrajectory> model(new FeatureTrajectory);
   model->options_ = options;
   model->mean_ = std::move(mean);
   model->origin_ = t_begin;
-  // A run with one time still needs a window of positive length.
-  const double length = std::max(t_end - t_begin, 1e-3);
   model->position_kernel_ = CreateKernel(options.position_kernel, error);
   if (!model->position_kernel_) return nullptr;
   model->heading_kernel_ = CreateKernel(options.heading_kernel, error);
@@ -183,9 +227,9 @@ std::vector<TrajectoryModel::PriorScale> FeatureTrajectory::PriorRowScales(
   const int block = static_cast<int>(
       std::upper_bound(offsets_.begin(), offsets_.end(), offset) -
       offsets_.begin() - 1);
-  return std::vector<PriorScale>(
-      num_rows, block % 3 == kTheta ? PriorScale::kHeading
-                                    : PriorScale::kPosition);
+  return std::vector<PriorScale>(num_rows, block % 3 == kTheta
+                                               ? PriorScale::kHeading
+                                               : PriorScale::kPosition);
 }
 
 void FeatureTrajectory::AddPriorCosts(ceres::Problem* problem, int begin,

@@ -49,6 +49,12 @@ struct FeatureTrajectoryOptions {
 
 inline constexpr int kAutoCapacity = 0;
 inline constexpr int kMaxAutoFeatures = 512;
+// Bounds of a requested basis: the whitening prior of a segment's D weights
+// is a dense D x D Jacobian block (3 x 2048^2 doubles: 100 MB), and the
+// blocks of every segment are held at once.
+inline constexpr int kMaxFeatures = 2048;
+inline constexpr int kMaxSegments = 100000;
+inline constexpr double kMaxPriorNonZeros = 2e8;  // 1.6 GB of Jacobian.
 
 // Capacity from the data's time scale rather than a constant: with
 // num_position_features == kAutoCapacity, segments of kSegmentLengthscales

@@ -7,6 +7,7 @@
 #include <map>
 #include <set>
 
+#include "rff_ceres/io/output_file.h"
 #include "rff_ceres/io/text_parser.h"
 
 namespace rff {
@@ -155,22 +156,43 @@ ErrorSummary Summarize(std::vector<double> values,
   }
   summary.available = true;
   summary.count = static_cast<int>(values.size());
-  double sum = 0.0, sum_squares = 0.0;
-  for (const double v : values) {
-    sum += v;
-    sum_squares += v * v;
-    summary.max = std::max(summary.max, v);
-  }
+  for (const double v : values) summary.max = std::max(summary.max, v);
+  // Scaled by the largest, so that errors near the double range neither
+  // overflow their squares nor their sum.
   const double n = static_cast<double>(values.size());
-  summary.mean = sum / n;
-  summary.rms = std::sqrt(sum_squares / n);
+  const double scale = summary.max > 0.0 ? summary.max : 1.0;
+  double mean = 0.0, mean_square = 0.0;
+  for (const double v : values) {
+    mean += (v / scale) / n;
+    mean_square += (v / scale) * (v / scale) / n;
+  }
+  summary.mean = scale * mean;
+  summary.rms = scale * std::sqrt(mean_square);
   std::sort(values.begin(), values.end());
   const std::size_t middle = values.size() / 2;
   summary.median = values.size() % 2 == 1
                        ? values[middle]
-                       : 0.5 * (values[middle - 1] + values[middle]);
+                       : 0.5 * values[middle - 1] + 0.5 * values[middle];
   return summary;
 }
+
+namespace {
+
+// Errors between finite poses can still overflow (poses 1e308 apart).
+bool CheckFiniteErrors(const std::vector<double>& values, const char* what,
+                       std::string* error) {
+  for (const double v : values) {
+    if (!std::isfinite(v)) {
+      *error = std::string(what) +
+               " overflows double precision: the estimate is too far from "
+               "the ground truth";
+      return false;
+    }
+  }
+  return true;
+}
+
+}  // namespace
 
 bool Evaluate(const std::vector<TimedPose>& ground_truth,
               const std::vector<Landmark>& ground_truth_landmarks,
@@ -228,6 +250,10 @@ bool Evaluate(const std::vector<TimedPose>& ground_truth,
     ape_translation.push_back(std::hypot(e.x, e.y));
     ape_rotation.push_back(std::abs(e.theta));
   }
+  if (!CheckFiniteErrors(ape_translation, "the APE translation", error) ||
+      !CheckFiniteErrors(ape_rotation, "the APE rotation", error)) {
+    return false;
+  }
   evaluation->ape_translation = Summarize(ape_translation, "");
   evaluation->ape_rotation = Summarize(ape_rotation, "");
 
@@ -241,6 +267,10 @@ bool Evaluate(const std::vector<TimedPose>& ground_truth,
   const std::string rpe_reason =
       "RPE needs at least 2 ground-truth poses, got " +
       std::to_string(truth.size());
+  if (!CheckFiniteErrors(rpe_translation, "the RPE translation", error) ||
+      !CheckFiniteErrors(rpe_rotation, "the RPE rotation", error)) {
+    return false;
+  }
   evaluation->rpe_translation = Summarize(rpe_translation, rpe_reason);
   evaluation->rpe_rotation = Summarize(rpe_rotation, rpe_reason);
 
@@ -275,6 +305,7 @@ bool Evaluate(const std::vector<TimedPose>& ground_truth,
     distances.push_back(std::hypot(found->second.x - truth_landmark.x,
                                    found->second.y - truth_landmark.y));
   }
+  if (!CheckFiniteErrors(distances, "the landmark error", error)) return false;
   landmarks.matched = static_cast<int>(distances.size());
   for (const auto& entry : by_id) {
     if (has_truth.count(entry.first) == 0) ++landmarks.unmatched_estimates;
@@ -415,10 +446,10 @@ bool WriteEvaluationJson(
     const Evaluation& evaluation,
     const std::vector<std::pair<std::string, std::string>>& inputs,
     const std::string& path, std::string* error) {
-  std::ofstream stream;
-  if (!OpenForWriting(path, &stream, error)) return false;
-  WriteEvaluationJson(evaluation, inputs, &stream);
-  return FinishWriting(path, &stream, error);
+  OutputFile file(path);
+  if (!file.Open(error)) return false;
+  WriteEvaluationJson(evaluation, inputs, &file.stream());
+  return file.Commit(error);
 }
 
 }  // namespace rff

@@ -50,9 +50,15 @@ bool ValidateSlamOptions(const SlamOptions& options, std::string* error) {
              FormatNumber(options.solver.max_memory_gb);
     return false;
   }
-  if (options.outer_rounds < 0) {
-    *error = "outer_rounds must be >= 0, got " +
-             std::to_string(options.outer_rounds);
+  if (options.outer_rounds < 0 || options.outer_rounds > kMaxOuterRounds) {
+    *error = "outer_rounds must be in [0, " + std::to_string(kMaxOuterRounds) +
+             "], got " + std::to_string(options.outer_rounds);
+    return false;
+  }
+  if (!(options.problem.max_preintegration_seconds >= 0.0) ||
+      !std::isfinite(options.problem.max_preintegration_seconds)) {
+    *error = "max_preintegration_seconds must be finite and >= 0, got " +
+             FormatNumber(options.problem.max_preintegration_seconds);
     return false;
   }
   if (!(options.spline_smoothing >= 0.0 && options.spline_smoothing <= 1.0)) {

@@ -126,12 +126,13 @@ bool SlamProblem::Begin(const std::vector<LandmarkId>& landmark_ids,
         return false;
       }
     }
-    Remember(problem_->AddResidualBlock(
-                 new DiagonalPriorCost(Eigen::Vector2d(1.0, 0.0),
-                                       Eigen::Vector2d(calibration.scale_sigma,
-                                                       calibration.offset_sigma)),
-                 nullptr, range_calibration_.data()),
-             {"range calibration prior"});
+    Remember(
+        problem_->AddResidualBlock(
+            new DiagonalPriorCost(Eigen::Vector2d(1.0, 0.0),
+                                  Eigen::Vector2d(calibration.scale_sigma,
+                                                  calibration.offset_sigma)),
+            nullptr, range_calibration_.data()),
+        {"range calibration prior"});
     // A physical sensor: the scale stays within a factor 2 of one and the
     // offset within kMaxOffsetSigmas of its prior; a bound that holds the
     // solution is reported as suspect (quality_report.h).
@@ -191,9 +192,11 @@ void SlamProblem::AddOdometry(const PreintegratedOdometry& o) {
            {"odometry", o.t0, o.t1});
 }
 
-std::vector<PreintegratedOdometry> SlamProblem::OdometryResiduals(
-    const Dataset& dataset) const {
-  if (!options_.use_odometry) return {};
+bool SlamProblem::OdometryResiduals(
+    const Dataset& dataset, std::vector<PreintegratedOdometry>* residuals,
+    std::string* error) const {
+  residuals->clear();
+  if (!options_.use_odometry) return true;
   // Chains end at every time a pose is needed; without preintegration,
   // at every record (each record is a chain of its own).
   std::vector<double> keep_times;
@@ -203,8 +206,18 @@ std::vector<PreintegratedOdometry> SlamProblem::OdometryResiduals(
     for (const Odometry& o : dataset.odometry) keep_times.push_back(o.t0);
   }
   std::sort(keep_times.begin(), keep_times.end());
-  return PreintegrateOdometry(dataset.odometry, keep_times,
-                              options_.max_preintegration_seconds);
+  *residuals = PreintegrateOdometry(dataset.odometry, keep_times,
+                                    options_.max_preintegration_seconds);
+  for (const PreintegratedOdometry& o : *residuals) {
+    if (!SqrtInformation(o.covariance).allFinite()) {
+      *error = "odometry from t = " + FormatNumber(o.t0) + " to " +
+               FormatNumber(o.t1) +
+               ": its covariance cannot be inverted in double precision "
+               "(sigmas too small)";
+      return false;
+    }
+  }
+  return true;
 }
 
 bool SlamProblem::Build(const Dataset& dataset,
@@ -224,9 +237,9 @@ bool SlamProblem::Build(const Dataset& dataset,
   for (const auto& [id, position] : landmarks) AddLandmark(id, position);
   for (const PosePrior& p : dataset.pose_priors) AddPosePrior(p);
   for (const LandmarkPrior& p : dataset.landmark_priors) AddLandmarkPrior(p);
-  for (const PreintegratedOdometry& o : OdometryResiduals(dataset)) {
-    AddOdometry(o);
-  }
+  std::vector<PreintegratedOdometry> odometry;
+  if (!OdometryResiduals(dataset, &odometry, error)) return false;
+  for (const PreintegratedOdometry& o : odometry) AddOdometry(o);
   for (const Observation& o : dataset.observations) AddObservation(o);
   return true;
 }
@@ -366,7 +379,8 @@ std::vector<VarianceGroup> SlamProblem::RowGroups(
   std::vector<VarianceGroup> rows;
   std::vector<double*> blocks;
   for (const ceres::ResidualBlockId id : ids) {
-    const int n = problem_->GetCostFunctionForResidualBlock(id)->num_residuals();
+    const int n =
+        problem_->GetCostFunctionForResidualBlock(id)->num_residuals();
     const auto source = sources_.find(id);
     if (source == sources_.end()) {  // The trajectory model's own prior.
       problem_->GetParameterBlocksForResidualBlock(id, &blocks);

@@ -122,9 +122,11 @@ class SlamProblem {
   void AddOdometry(const PreintegratedOdometry& odometry);
   void AddObservation(const Observation& observation);
   // The odometry residuals of `dataset` under the options (composed chains
-  // ending at every observation and prior time, or one per record).
-  std::vector<PreintegratedOdometry> OdometryResiduals(
-      const Dataset& dataset) const;
+  // ending at every observation and prior time, or one per record); fails
+  // when a covariance cannot be inverted.
+  bool OdometryResiduals(const Dataset& dataset,
+                         std::vector<PreintegratedOdometry>* residuals,
+                         std::string* error) const;
 
   ceres::Problem* problem() { return problem_.get(); }
   // (scale, offset) of the range sensor: (1, 0) unless estimated. Set it

@@ -1,10 +1,17 @@
 #include "rff_ceres/slam_report.h"
 
 #include <algorithm>
-#include <fstream>
+#include <cerrno>
+#include <cstring>
+#include <memory>
+#include <vector>
 
 #include "ceres/types.h"
+#include "rff_ceres/io/landmarks_io.h"
+#include "rff_ceres/io/output_file.h"
+#include "rff_ceres/io/pose_covariance_io.h"
 #include "rff_ceres/io/text_parser.h"
+#include "rff_ceres/io/tum_io.h"
 
 namespace rff {
 namespace {
@@ -103,10 +110,9 @@ void PrintSlamSummary(const SlamOptions& options, const SlamResult& result,
   }
 }
 
-bool WriteSummaryJson(const SlamOptions& options, const SlamResult& result,
-                      const std::string& path, std::string* error) {
-  std::ofstream out;
-  if (!OpenForWriting(path, &out, error)) return false;
+void WriteSummaryJson(const SlamOptions& options, const SlamResult& result,
+                      std::ostream* output) {
+  std::ostream& out = *output;
   const ceres::Solver::Summary& s = result.summary;
   const FeatureTrajectoryOptions& t = result.trajectory_options;
   double update_mean, update_max;
@@ -203,7 +209,60 @@ bool WriteSummaryJson(const SlamOptions& options, const SlamResult& result,
       << "  \"update_seconds_mean\": " << FormatNumber(update_mean) << ",\n"
       << "  \"update_seconds_max\": " << FormatNumber(update_max) << "\n"
       << "}\n";
-  return FinishWriting(path, &out, error);
+}
+
+bool WriteSummaryJson(const SlamOptions& options, const SlamResult& result,
+                      const std::string& path, std::string* error) {
+  OutputFile file(path);
+  if (!file.Open(error)) return false;
+  WriteSummaryJson(options, result, &file.stream());
+  return file.Commit(error);
+}
+
+bool WriteSlamOutputs(const SlamOptions& options, const SlamResult& result,
+                      const SlamOutputPaths& paths, std::string* error) {
+  std::vector<std::unique_ptr<OutputFile>> staged;
+  auto stage = [&](const std::string& path) -> std::ostream* {
+    if (path.empty()) return nullptr;
+    staged.push_back(std::make_unique<OutputFile>(path));
+    return staged.back()->Open(error) ? &staged.back()->stream() : nullptr;
+  };
+  if (std::ostream* out = stage(paths.trajectory)) {
+    WriteTum(result.trajectory, out);
+  } else if (!paths.trajectory.empty()) {
+    return false;
+  }
+  if (std::ostream* out = stage(paths.landmarks)) {
+    WriteLandmarks(result.landmarks, out);
+  } else if (!paths.landmarks.empty()) {
+    return false;
+  }
+  if (std::ostream* out = stage(paths.covariance)) {
+    if (!WritePoseCovariances(result.trajectory, result.pose_covariances, out,
+                              error)) {
+      *error = paths.covariance + ": " + *error;
+      return false;
+    }
+  } else if (!paths.covariance.empty()) {
+    return false;
+  }
+  if (std::ostream* out = stage(paths.summary_json)) {
+    WriteSummaryJson(options, result, out);
+  } else if (!paths.summary_json.empty()) {
+    return false;
+  }
+  // Every file is complete before any replaces its path.
+  for (const auto& file : staged) {
+    file->stream().flush();
+    if (!file->stream()) {
+      *error = file->path() + ": write failed: " + std::strerror(errno);
+      return false;
+    }
+  }
+  for (const auto& file : staged) {
+    if (!file->Commit(error)) return false;
+  }
+  return true;
 }
 
 }  // namespace rff

@@ -77,6 +77,14 @@ bool ToCeresOptions(const SolverOptions& options,
              "CLUSTER_TRIDIAGONAL)";
     return false;
   }
+  // SUBSET needs residual blocks chosen for it, which no flag can give.
+  if (ceres_options->preconditioner_type == ceres::SUBSET) {
+    *error =
+        "preconditioner SUBSET is not supported (it needs residual blocks "
+        "chosen for it); use IDENTITY, JACOBI, SCHUR_JACOBI, CLUSTER_JACOBI "
+        "or CLUSTER_TRIDIAGONAL";
+    return false;
+  }
   // Ceres 2.1's CGNR aborts on any other preconditioner.
   if (ceres_options->linear_solver_type == ceres::CGNR &&
       ceres_options->preconditioner_type != ceres::IDENTITY &&
@@ -371,8 +379,8 @@ bool SolveIncremental(const Dataset& dataset, const SlamOptions& options,
     slam.AddLandmark(p.id, Eigen::Vector2d(p.x, p.y));
     slam.AddLandmarkPrior(p);
   }
-  const std::vector<PreintegratedOdometry> odometry =
-      slam.OdometryResiduals(dataset);
+  std::vector<PreintegratedOdometry> odometry;
+  if (!slam.OdometryResiduals(dataset, &odometry, error)) return false;
   std::size_t next_odometry = 0, next_prior = 0;
   int prior_end = 0;  // Trajectory prior terms added for blocks below this.
   std::vector<Observation> pending;  // Of landmarks not located yet.

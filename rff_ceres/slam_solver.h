@@ -57,6 +57,9 @@ struct IncrementalOptions {
   double lag = 0.0;
 };
 
+// Refits of the spline mean stop changing it after a few rounds (III-B.2).
+inline constexpr int kMaxOuterRounds = 100;
+
 struct SlamOptions {
   // Trajectory prior: "rff" (weight-space features, FeatureTrajectory) or
   // "wnoa" (LTV-SDE states, WnoaTrajectory).
@@ -86,7 +89,8 @@ struct SlamOptions {
   ProblemOptions problem;
   SolverOptions solver;
   // Outer rounds of the paper's smoothing-spline prior (III-B.2): after each
-  // solve, refit the mean to the estimate and solve again. 0: one solve.
+  // solve, refit the mean to the estimate and solve again. 0: one solve; at
+  // most kMaxOuterRounds.
   int outer_rounds = 0;
   double spline_smoothing = 0.98;  // De Boor's p.
   // Posterior covariance of every output pose and landmark (see

@@ -3,8 +3,6 @@
 // and leaves no output file (in particular none with NaN or inf). The
 // solver-level cases (degenerate but valid datasets) check that rff_slam
 // either solves them to a finite trajectory or fails cleanly.
-#include <sys/wait.h>
-
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -16,99 +14,20 @@
 #include "gtest/gtest.h"
 #include "rff_ceres/io/text_parser.h"
 #include "rff_ceres/io/tum_io.h"
+#include "test/app_runner.h"
 #include "test/test_files.h"
 
 namespace rff {
 namespace {
 
+using testing::Expand;
+using testing::HasNonFiniteToken;
 using ::testing::HasSubstr;
 using testing::ReadFile;
+using testing::RunCommand;
+using testing::RunResult;
+using testing::ValidDataset;
 using testing::WriteFile;
-
-struct RunResult {
-  int exit_code = -1;  // 128 + signal when killed by a signal.
-  std::string output;  // stdout and stderr.
-};
-
-// Runs `command` through the shell with a time limit (a hang is a failure:
-// exit code 124).
-RunResult RunCommand(const std::string& command) {
-  RunResult result;
-  const std::string full = "timeout 300 " + command + " 2>&1";
-  FILE* pipe = popen(full.c_str(), "r");
-  if (pipe == nullptr) return result;
-  char buffer[4096];
-  std::size_t n;
-  while ((n = std::fread(buffer, 1, sizeof(buffer), pipe)) > 0) {
-    result.output.append(buffer, n);
-  }
-  const int status = pclose(pipe);
-  if (WIFEXITED(status)) {
-    result.exit_code = WEXITSTATUS(status);
-  } else if (WIFSIGNALED(status)) {
-    result.exit_code = 128 + WTERMSIG(status);
-  }
-  return result;
-}
-
-// Replaces {bin} (the build directory) and {dir} (the test's scratch
-// directory) in `pattern`.
-std::string Expand(std::string pattern, const std::string& dir) {
-  const std::pair<std::string, std::string> keys[] = {{"{bin}", RFF_BINARY_DIR},
-                                                      {"{dir}", dir}};
-  for (const auto& [key, value] : keys) {
-    for (std::size_t at = pattern.find(key); at != std::string::npos;
-         at = pattern.find(key, at + value.size())) {
-      pattern.replace(at, key.size(), value);
-    }
-  }
-  return pattern;
-}
-
-bool HasNonFiniteToken(const std::string& text) {
-  std::istringstream in(text);
-  std::string token;
-  while (in >> token) {
-    std::string lower;
-    for (const char c : token) lower += static_cast<char>(std::tolower(c));
-    if (lower.find("nan") != std::string::npos ||
-        lower.find("inf") != std::string::npos) {
-      return true;
-    }
-  }
-  return false;
-}
-
-// The robot drives along x at 1 m/s for 10 s; three landmarks with priors;
-// noise-free range-bearing every second and odometry between. Times start
-// at `t0` (0, or a Unix-epoch time).
-std::string ValidDataset(double t0) {
-  auto n = [](double v) { return FormatNumber(v); };
-  std::ostringstream out;
-  out << "# source: app_errors_test\nRFFD 1\n"
-      << "PRIOR_POSE " << n(t0) << " 0 0 0 0.1 0.01\n";
-  const double landmarks[3][2] = {{5, 5}, {5, -5}, {10, 3}};
-  for (int i = 0; i < 3; ++i) {
-    out << "PRIOR_LANDMARK " << i + 1 << " " << landmarks[i][0] << " "
-        << landmarks[i][1] << " 1\n";
-    out << "GT_LANDMARK " << i + 1 << " " << landmarks[i][0] << " "
-        << landmarks[i][1] << "\n";
-  }
-  for (int k = 0; k <= 10; ++k) {
-    const double t = t0 + k;
-    if (k < 10) {
-      out << "ODOM " << n(t) << " " << n(t + 1) << " 1 0 0 0.05 0.05 0.01\n";
-    }
-    for (int i = 0; i < 3; ++i) {
-      const double dx = landmarks[i][0] - k, dy = landmarks[i][1];
-      out << "RANGE_BEARING " << n(t) << " " << i + 1 << " "
-          << n(std::hypot(dx, dy)) << " " << n(std::atan2(dy, dx))
-          << " 0.1 0.02\n";
-    }
-    out << "GT_POSE " << n(t) << " " << k << " 0 0\n";
-  }
-  return out.str();
-}
 
 // ---------------------------------------------------------------------------
 // Errors: one command per case. {dir}/valid.rffd holds ValidDataset(0),
@@ -160,7 +79,9 @@ const AppCase kAppCases[] = {
      "rff_slam: error: unexpected argument 'extra'", "{dir}/out.tum"},
     {"SlamUnwritableOutput",
      SLAM "--output_trajectory={dir}/no/such/dir/out.tum",
-     "{dir}/no/such/dir/out.tum: cannot open for writing", ""},
+     "rff_slam: error: --output_trajectory={dir}/no/such/dir/out.tum: "
+     "directory '{dir}/no/such/dir' does not exist",
+     ""},
     // rff_slam: flags (gflags itself rejects unknown and malformed ones).
     {"SlamUnknownFlag", SLAM "--no_such_flag=1" SLAM_OUT,
      "unknown command line flag 'no_such_flag'", "{dir}/out.tum"},
@@ -168,7 +89,8 @@ const AppCase kAppCases[] = {
      "illegal value 'abc' specified for int32 flag 'num_features'",
      "{dir}/out.tum"},
     {"SlamNegativeD", SLAM "--num_features=-5" SLAM_OUT,
-     "hilbert: num_features must be in [1, ", "{dir}/out.tum"},
+     "num_features must be in [0, 2048] (0: from the capacity rule), got -5",
+     "{dir}/out.tum"},
     {"SlamBadLearning", SLAM "--learn_hyperparameters=maybe" SLAM_OUT,
      "learn_hyperparameters must be auto, on or off, got 'maybe'",
      "{dir}/out.tum"},
@@ -239,7 +161,7 @@ const AppCase kAppCases[] = {
      "rff_slam: error: prior must be rff or wnoa, got 'brownian'",
      "{dir}/out.tum"},
     {"SlamNegativeOuterRounds", SLAM "--outer_rounds=-1" SLAM_OUT,
-     "outer_rounds must be >= 0, got -1", "{dir}/out.tum"},
+     "outer_rounds must be in [0, 100], got -1", "{dir}/out.tum"},
     {"SlamSplineSmoothingAboveOne", SLAM "--spline_smoothing=2" SLAM_OUT,
      "spline_smoothing must be in [0, 1], got 2", "{dir}/out.tum"},
     // rff_convert.
@@ -345,8 +267,8 @@ const AppCase kAppCases[] = {
     {"PerturbOutputIsInput",
      "{bin}/rff_perturb --input={dir}/valid.rffd --output={dir}/valid.rffd "
      "--landmark_prior_offset=1",
-     "rff_perturb: error: output {dir}/valid.rffd is the input file "
-     "{dir}/valid.rffd; write the perturbed dataset elsewhere",
+     "rff_perturb: error: --output={dir}/valid.rffd: the same file as the "
+     "input --input={dir}/valid.rffd; refusing to overwrite an input",
      ""},
     {"PerturbMissingInput",
      "{bin}/rff_perturb --input={dir}/none.rffd --output={dir}/p.rffd",

@@ -180,7 +180,7 @@ INSTANTIATE_TEST_SUITE_P(
                   "overlap < length"},
         BadOption{"NegativeOuterRounds",
                   [](SlamOptions* o) { o->outer_rounds = -1; },
-                  "outer_rounds must be >= 0"},
+                  "outer_rounds must be in [0, 100], got -1"},
         BadOption{"SplineSmoothingAboveOne",
                   [](SlamOptions* o) { o->spline_smoothing = 1.5; },
                   "spline_smoothing must be in [0, 1]"},

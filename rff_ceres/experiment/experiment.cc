@@ -13,6 +13,7 @@
 #include "rff_ceres/convert/mrclam.h"
 #include "rff_ceres/dead_reckoning.h"
 #include "rff_ceres/io/dataset_io.h"
+#include "rff_ceres/io/output_file.h"
 #include "rff_ceres/io/text_parser.h"
 #include "rff_ceres/metrics.h"
 #include "rff_ceres/plot/svg_plot.h"
@@ -246,10 +247,10 @@ void SolveAndEvaluate(const Dataset& dataset, const SlamOptions& base,
 
 bool WriteText(const std::string& path, const std::string& text,
                ExperimentSummary* summary, std::string* error) {
-  std::ofstream stream;
-  if (!OpenForWriting(path, &stream, error)) return false;
-  stream << text;
-  if (!FinishWriting(path, &stream, error)) return false;
+  OutputFile file(path);
+  if (!file.Open(error)) return false;
+  file.stream() << text;
+  if (!file.Commit(error)) return false;
   if (std::find(summary->files.begin(), summary->files.end(), path) ==
       summary->files.end()) {
     summary->files.push_back(path);

@@ -6,6 +6,7 @@
 #include <set>
 #include <sstream>
 
+#include "rff_ceres/io/output_file.h"
 #include "rff_ceres/io/text_parser.h"
 
 namespace rff {
@@ -330,10 +331,10 @@ void WriteDataset(const Dataset& dataset, std::ostream* output) {
 
 bool WriteDataset(const Dataset& dataset, const std::string& path,
                   std::string* error) {
-  std::ofstream stream;
-  if (!OpenForWriting(path, &stream, error)) return false;
-  WriteDataset(dataset, &stream);
-  return FinishWriting(path, &stream, error);
+  OutputFile file(path);
+  if (!file.Open(error)) return false;
+  WriteDataset(dataset, &file.stream());
+  return file.Commit(error);
 }
 
 }  // namespace rff

@@ -5,6 +5,7 @@
 #include <fstream>
 #include <set>
 
+#include "rff_ceres/io/output_file.h"
 #include "rff_ceres/io/text_parser.h"
 
 namespace rff {
@@ -26,10 +27,10 @@ void WriteLandmarks(std::vector<Landmark> landmarks, std::ostream* output) {
 
 bool WriteLandmarks(const std::vector<Landmark>& landmarks,
                     const std::string& path, std::string* error) {
-  std::ofstream stream;
-  if (!OpenForWriting(path, &stream, error)) return false;
-  WriteLandmarks(landmarks, &stream);
-  return FinishWriting(path, &stream, error);
+  OutputFile file(path);
+  if (!file.Open(error)) return false;
+  WriteLandmarks(landmarks, &file.stream());
+  return file.Commit(error);
 }
 
 bool ParseLandmarks(std::istream* input, const std::string& source,

@@ -4,6 +4,7 @@
 #include <fstream>
 
 #include "Eigen/Eigenvalues"
+#include "rff_ceres/io/output_file.h"
 #include "rff_ceres/io/text_parser.h"
 
 namespace rff {
@@ -63,18 +64,17 @@ void WritePoseCovariances(const std::vector<PoseCovariance>& covariances,
 
 bool WritePoseCovariances(const std::vector<PoseCovariance>& covariances,
                           const std::string& path, std::string* error) {
-  std::ofstream stream;
-  if (!OpenForWriting(path, &stream, error)) return false;
-  WritePoseCovariances(covariances, &stream);
-  return FinishWriting(path, &stream, error);
+  OutputFile file(path);
+  if (!file.Open(error)) return false;
+  WritePoseCovariances(covariances, &file.stream());
+  return file.Commit(error);
 }
 
 bool WritePoseCovariances(const std::vector<TimedPose>& trajectory,
                           const std::vector<Eigen::Matrix3d>& covariances,
-                          const std::string& path, std::string* error) {
+                          std::ostream* output, std::string* error) {
   if (trajectory.size() != covariances.size()) {
-    *error = "cannot write " + path + ": " +
-             std::to_string(covariances.size()) + " covariances for " +
+    *error = std::to_string(covariances.size()) + " covariances for " +
              std::to_string(trajectory.size()) + " poses";
     return false;
   }
@@ -83,7 +83,8 @@ bool WritePoseCovariances(const std::vector<TimedPose>& trajectory,
     timed[k].t = trajectory[k].t;
     timed[k].covariance = covariances[k];
   }
-  return WritePoseCovariances(timed, path, error);
+  WritePoseCovariances(timed, output);
+  return true;
 }
 
 bool ParsePoseCovariances(std::istream* input, const std::string& source,

@@ -29,7 +29,7 @@ bool WritePoseCovariances(const std::vector<PoseCovariance>& covariances,
 // its trajectory; fails when the two lengths differ.
 bool WritePoseCovariances(const std::vector<TimedPose>& trajectory,
                           const std::vector<Eigen::Matrix3d>& covariances,
-                          const std::string& path, std::string* error);
+                          std::ostream* output, std::string* error);
 
 // Reads a pose covariance file. Times must strictly increase; each
 // covariance must be symmetric positive semi-definite: variances >= 0,

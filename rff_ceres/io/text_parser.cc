@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <limits>
 
@@ -169,29 +170,14 @@ std::string JoinAlternatives(const std::vector<std::string>& names) {
 
 bool OpenForReading(const std::string& path, std::ifstream* stream,
                     std::string* error) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) {
+    *error = path + ": cannot open for reading: is a directory, not a file";
+    return false;
+  }
   stream->open(path, std::ios::in | std::ios::binary);
   if (!stream->is_open()) {
     *error = path + ": cannot open for reading: " + std::strerror(errno);
-    return false;
-  }
-  return true;
-}
-
-bool OpenForWriting(const std::string& path, std::ofstream* stream,
-                    std::string* error) {
-  stream->open(path, std::ios::out | std::ios::trunc);
-  if (!stream->is_open()) {
-    *error = path + ": cannot open for writing: " + std::strerror(errno);
-    return false;
-  }
-  return true;
-}
-
-bool FinishWriting(const std::string& path, std::ofstream* stream,
-                   std::string* error) {
-  stream->flush();
-  if (!*stream) {
-    *error = path + ": write failed: " + std::strerror(errno);
     return false;
   }
   return true;

@@ -85,14 +85,6 @@ std::string JsonString(const std::string& text);
 bool OpenForReading(const std::string& path, std::ifstream* stream,
                     std::string* error);
 
-// Opens `path` for writing; on failure sets `error`.
-bool OpenForWriting(const std::string& path, std::ofstream* stream,
-                    std::string* error);
-
-// Flushes `stream` and reports a failed write of `path` through `error`.
-bool FinishWriting(const std::string& path, std::ofstream* stream,
-                   std::string* error);
-
 // "a", "a or b", "a, b or c": the allowed values of an option, for messages.
 std::string JoinAlternatives(const std::vector<std::string>& names);
 

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <fstream>
 
+#include "rff_ceres/io/output_file.h"
 #include "rff_ceres/io/text_parser.h"
 
 namespace rff {
@@ -19,10 +20,10 @@ void WriteTum(const std::vector<TimedPose>& poses, std::ostream* output) {
 
 bool WriteTum(const std::vector<TimedPose>& poses, const std::string& path,
               std::string* error) {
-  std::ofstream stream;
-  if (!OpenForWriting(path, &stream, error)) return false;
-  WriteTum(poses, &stream);
-  return FinishWriting(path, &stream, error);
+  OutputFile file(path);
+  if (!file.Open(error)) return false;
+  WriteTum(poses, &file.stream());
+  return file.Commit(error);
 }
 
 bool ParseTum(std::istream* input, const std::string& source,

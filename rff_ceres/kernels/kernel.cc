@@ -52,10 +52,23 @@ std::string JoinedNames() {
   return joined;
 }
 
-bool CheckPositive(const char* what, double value, std::string* error) {
-  if (std::isfinite(value) && value > 0.0) return true;
+// Beyond these the features' frequencies and weights leave double range
+// (1e12 s is 30000 years; 1e24 m^2 a spread of 1e12 m).
+constexpr double kMaxTimeScale = 1e12;
+constexpr double kMaxVariance = 1e24;
+
+bool CheckPositive(const char* what, double value, double largest,
+                   std::string* error) {
   std::ostringstream message;
-  message << "kernel " << what << " must be positive and finite, got " << value;
+  if (!std::isfinite(value) || !(value > 0.0)) {
+    message << "kernel " << what << " must be positive and finite, got "
+            << value;
+  } else if (value > largest) {
+    message << "kernel " << what << " must be at most " << largest << ", got "
+            << value;
+  } else {
+    return true;
+  }
   *error = message.str();
   return false;
 }
@@ -82,12 +95,15 @@ std::unique_ptr<Kernel> CreateKernel(const KernelOptions& options,
                                      std::string* error) {
   for (const KernelEntry& entry : Registry()) {
     if (options.name != entry.name) continue;
-    if (!CheckPositive("variance", options.variance, error) ||
-        !CheckPositive("lengthscale", options.lengthscale, error)) {
+    if (!CheckPositive("variance", options.variance, kMaxVariance, error) ||
+        !CheckPositive("lengthscale", options.lengthscale, kMaxTimeScale,
+                       error)) {
       return nullptr;
     }
     if (options.name == "periodic") {
-      if (!CheckPositive("period", options.period, error)) return nullptr;
+      if (!CheckPositive("period", options.period, kMaxTimeScale, error)) {
+        return nullptr;
+      }
       // Below this the series needs more than ~12000 terms (white noise).
       if (options.lengthscale < 1e-3) {
         std::ostringstream message;

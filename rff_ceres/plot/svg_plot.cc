@@ -7,6 +7,7 @@
 #include <limits>
 #include <sstream>
 
+#include "rff_ceres/io/output_file.h"
 #include "rff_ceres/io/text_parser.h"
 
 namespace rff {
@@ -384,10 +385,10 @@ bool WriteSvg(const Plot& plot, const std::string& path, std::string* error) {
     *error = path + ": " + *error;
     return false;
   }
-  std::ofstream stream;
-  if (!OpenForWriting(path, &stream, error)) return false;
-  stream << svg;
-  return FinishWriting(path, &stream, error);
+  OutputFile file(path);
+  if (!file.Open(error)) return false;
+  file.stream() << svg;
+  return file.Commit(error);
 }
 
 }  // namespace rff

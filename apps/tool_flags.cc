@@ -1,0 +1,31 @@
+#include "tool_flags.h"
+
+#include <csignal>
+#include <vector>
+
+#include "gflags/gflags.h"
+#include "rff_ceres/io/flagfile_check.h"
+
+namespace rff {
+
+bool IsKnownToolFlag(const std::string& name) {
+  gflags::CommandLineFlagInfo info;
+  if (gflags::GetCommandLineFlagInfo(name.c_str(), &info)) return true;
+  return name.rfind("no", 0) == 0 &&
+         gflags::GetCommandLineFlagInfo(name.substr(2).c_str(), &info) &&
+         info.type == "bool";
+}
+
+bool ParseToolFlags(int* argc, char*** argv, std::string* error) {
+  std::signal(SIGXFSZ, SIG_IGN);
+  const std::vector<std::string> args(*argv + 1, *argv + *argc);
+  if (!CheckFlagfiles(args, IsKnownToolFlag, error)) return false;
+  gflags::ParseCommandLineFlags(argc, argv, true);
+  if (*argc > 1) {
+    *error = std::string("unexpected argument '") + (*argv)[1] + "'";
+    return false;
+  }
+  return true;
+}
+
+}  // namespace rff

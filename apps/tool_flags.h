@@ -1,0 +1,22 @@
+// Command-line parsing shared by every tool: the flagfiles are checked
+// before gflags reads them (rff_ceres/io/flagfile_check.h), a leftover
+// argument is an error, and a write past the file-size limit fails with an
+// error instead of killing the process (SIGXFSZ).
+#ifndef RFF_APPS_TOOL_FLAGS_H_
+#define RFF_APPS_TOOL_FLAGS_H_
+
+#include <string>
+
+namespace rff {
+
+// Parses the flags and removes them from argv; false with `error` set when
+// a flagfile is bad or an argument is left over. gflags itself exits on an
+// unknown or malformed flag.
+bool ParseToolFlags(int* argc, char*** argv, std::string* error);
+
+// Whether the tool defines a flag of this name ("noname" for a boolean).
+bool IsKnownToolFlag(const std::string& name);
+
+}  // namespace rff
+
+#endif  // RFF_APPS_TOOL_FLAGS_H_

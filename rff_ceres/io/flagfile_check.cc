@@ -1,0 +1,115 @@
+#include "rff_ceres/io/flagfile_check.h"
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace rff {
+namespace {
+
+// Flagfiles deeper than this are an error even without a cycle.
+constexpr int kMaxFlagfileDepth = 32;
+
+// "--name=value" or "-name": the name; empty when `arg` is not a flag.
+std::string FlagName(const std::string& arg) {
+  std::size_t begin = 0;
+  while (begin < arg.size() && begin < 2 && arg[begin] == '-') ++begin;
+  if (begin == 0) return "";
+  return arg.substr(begin, arg.find('=') == std::string::npos
+                               ? std::string::npos
+                               : arg.find('=') - begin);
+}
+
+std::string FlagValue(const std::string& arg) {
+  const std::size_t equals = arg.find('=');
+  return equals == std::string::npos ? "" : arg.substr(equals + 1);
+}
+
+std::vector<std::string> SplitCommas(const std::string& list) {
+  std::vector<std::string> items;
+  std::stringstream in(list);
+  std::string item;
+  while (std::getline(in, item, ',')) {
+    if (!item.empty()) items.push_back(item);
+  }
+  return items;
+}
+
+std::string Trim(const std::string& text) {
+  const char* blanks = " \t\r\n";
+  const std::size_t begin = text.find_first_not_of(blanks);
+  if (begin == std::string::npos) return "";
+  return text.substr(begin, text.find_last_not_of(blanks) - begin + 1);
+}
+
+bool CheckFlagfile(const std::string& path, const FlagIsKnown& is_known,
+                   std::vector<std::string>* open, std::string* error) {
+  std::error_code ec;
+  const std::string canonical =
+      std::filesystem::weakly_canonical(path, ec).string();
+  for (const std::string& ancestor : *open) {
+    if (ancestor == canonical) {
+      *error = "--flagfile=" + path + ": includes itself" +
+               (open->size() > 1 ? " through other flagfiles" : "");
+      return false;
+    }
+  }
+  if (static_cast<int>(open->size()) >= kMaxFlagfileDepth) {
+    *error = "--flagfile=" + path + ": flagfiles nested more than " +
+             std::to_string(kMaxFlagfileDepth) + " deep";
+    return false;
+  }
+  if (std::filesystem::is_directory(path, ec)) {
+    *error = "--flagfile=" + path + ": is a directory";
+    return false;
+  }
+  std::ifstream in(path);
+  if (!in) {
+    *error = "--flagfile=" + path + ": cannot open for reading";
+    return false;
+  }
+  open->push_back(canonical);
+  std::string line;
+  for (int number = 1; std::getline(in, line); ++number) {
+    const std::string text = Trim(line);
+    if (text.empty() || text[0] == '#') continue;
+    const std::string where = path + ":" + std::to_string(number) + ": ";
+    const std::string name = FlagName(text);
+    if (name.empty()) {
+      *error =
+          where + "expected --name=value, got '" + text.substr(0, 80) + "'";
+      return false;
+    }
+    if (name == "flagfile") {
+      for (const std::string& nested : SplitCommas(FlagValue(text))) {
+        if (!CheckFlagfile(nested, is_known, open, error)) return false;
+      }
+    } else if (!is_known(name)) {
+      *error = where + "unknown flag '--" + name + "'";
+      return false;
+    }
+  }
+  open->pop_back();
+  return true;
+}
+
+}  // namespace
+
+bool CheckFlagfiles(const std::vector<std::string>& args,
+                    const FlagIsKnown& is_known, std::string* error) {
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    if (args[i] == "--") break;
+    if (FlagName(args[i]) != "flagfile") continue;
+    std::string list = FlagValue(args[i]);
+    if (args[i].find('=') == std::string::npos && i + 1 < args.size()) {
+      list = args[++i];
+    }
+    for (const std::string& path : SplitCommas(list)) {
+      std::vector<std::string> open;
+      if (!CheckFlagfile(path, is_known, &open, error)) return false;
+    }
+  }
+  return true;
+}
+
+}  // namespace rff

@@ -1,0 +1,179 @@
+#include "rff_ceres/io/output_file.h"
+
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <utility>
+
+namespace rff {
+namespace {
+
+namespace fs = std::filesystem;
+
+// The absolute, normalised form of `path` with its existing part resolved
+// (symbolic links included), so that two spellings of one file compare
+// equal.
+fs::path Resolved(const std::string& path) {
+  std::error_code ec;
+  fs::path resolved = fs::weakly_canonical(path, ec);
+  if (ec) resolved = fs::absolute(path, ec).lexically_normal();
+  return resolved;
+}
+
+bool SameFile(const std::string& a, const std::string& b) {
+  std::error_code ec;
+  if (fs::exists(a, ec) && fs::exists(b, ec)) {
+    const bool same = fs::equivalent(a, b, ec);
+    if (!ec) return same;
+  }
+  return Resolved(a) == Resolved(b);
+}
+
+// Whether `file` lies under the directory `directory`.
+bool IsUnder(const std::string& file, const std::string& directory) {
+  const fs::path dir = Resolved(directory);
+  const fs::path resolved = Resolved(file);
+  auto d = dir.begin();
+  auto f = resolved.begin();
+  for (; d != dir.end(); ++d, ++f) {
+    if (f == resolved.end() || *d != *f) return false;
+  }
+  return true;
+}
+
+std::string Named(const NamedPath& p) { return p.flag + "=" + p.path; }
+
+bool CheckDirectory(const NamedPath& output, std::string* error) {
+  std::error_code ec;
+  if (fs::is_directory(output.path, ec)) {
+    *error = Named(output) + ": is a directory; give a file name";
+    return false;
+  }
+  fs::path directory = fs::path(output.path).parent_path();
+  if (directory.empty()) directory = ".";
+  if (!fs::is_directory(directory, ec)) {
+    *error =
+        Named(output) + ": directory '" + directory.string() + "' " +
+        (fs::exists(directory, ec) ? "is not a directory" : "does not exist");
+    return false;
+  }
+  if (access(directory.c_str(), W_OK | X_OK) != 0) {
+    *error = Named(output) + ": directory '" + directory.string() +
+             "' is not writable: " + std::strerror(errno);
+    return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+bool CheckOutputPaths(const std::vector<NamedPath>& inputs,
+                      const std::vector<NamedPath>& outputs,
+                      std::string* error) {
+  std::vector<const NamedPath*> checked;
+  for (const NamedPath& output : outputs) {
+    if (output.path.empty()) continue;
+    if (!CheckDirectory(output, error)) return false;
+    for (const NamedPath& input : inputs) {
+      if (input.path.empty()) continue;
+      std::error_code ec;
+      const bool inside = fs::is_directory(input.path, ec) &&
+                          fs::exists(output.path, ec) &&
+                          IsUnder(output.path, input.path);
+      if (inside || SameFile(output.path, input.path)) {
+        *error = Named(output) + ": " +
+                 (inside ? "a file of the input directory "
+                         : "the same file as the input ") +
+                 Named(input) + "; refusing to overwrite an input";
+        return false;
+      }
+    }
+    for (const NamedPath* other : checked) {
+      if (SameFile(output.path, other->path)) {
+        *error = Named(output) + ": the same file as the output " +
+                 Named(*other) + "; each output needs its own path";
+        return false;
+      }
+    }
+    checked.push_back(&output);
+  }
+  return true;
+}
+
+OutputFile::OutputFile(std::string path) : path_(std::move(path)) {}
+
+OutputFile::~OutputFile() { Discard(); }
+
+void OutputFile::Discard() {
+  if (stream_.is_open()) stream_.close();
+  if (!temporary_.empty()) std::remove(temporary_.c_str());
+  temporary_.clear();
+}
+
+bool OutputFile::Open(std::string* error) {
+  Discard();
+  std::error_code ec;
+  if (fs::is_directory(path_, ec)) {
+    *error = path_ + ": cannot open for writing: is a directory";
+    return false;
+  }
+  std::string name = path_ + ".tmp.XXXXXX";
+  const int fd = mkstemp(name.data());
+  if (fd < 0) {
+    *error = path_ + ": cannot open for writing: " + std::strerror(errno);
+    return false;
+  }
+  // mkstemp creates the file 0600; give it the mode a new file would get.
+  const mode_t mask = umask(0);
+  umask(mask);
+  fchmod(fd, 0666 & ~mask);
+  close(fd);
+  temporary_ = name;
+  stream_.open(temporary_, std::ios::out | std::ios::trunc);
+  if (!stream_.is_open()) {
+    *error = path_ + ": cannot open for writing: " + std::strerror(errno);
+    Discard();
+    return false;
+  }
+  return true;
+}
+
+bool OutputFile::Commit(std::string* error) {
+  if (temporary_.empty()) {
+    *error = path_ + ": write failed: the file was not opened";
+    return false;
+  }
+  stream_.flush();
+  const bool written = static_cast<bool>(stream_);
+  const int write_errno = errno;
+  stream_.close();
+  if (!written || stream_.fail()) {
+    *error = path_ +
+             ": write failed: " + std::strerror(written ? errno : write_errno) +
+             "; the file was left as it was";
+    Discard();
+    return false;
+  }
+  if (std::rename(temporary_.c_str(), path_.c_str()) != 0) {
+    *error = path_ + ": cannot replace the file: " + std::strerror(errno);
+    Discard();
+    return false;
+  }
+  temporary_.clear();
+  return true;
+}
+
+bool WriteTextFile(const std::string& path, const std::string& text,
+                   std::string* error) {
+  OutputFile file(path);
+  if (!file.Open(error)) return false;
+  file.stream() << text;
+  return file.Commit(error);
+}
+
+}  // namespace rff
