@@ -71,7 +71,7 @@ DEFINE_double(gt_rate_hz, 10.0,
 namespace {
 
 int Fail(const std::string& message) {
-  std::fprintf(stderr, "rff_convert: %s\n", message.c_str());
+  std::fprintf(stderr, "rff_convert: error: %s\n", message.c_str());
   return 1;
 }
 

@@ -660,8 +660,10 @@ std::string SettlePriorMean(const SlamOptions& options,
   return options.prior == "rff" && batch ? "wnoa" : "odometry";
 }
 
-bool RunSlam(const Dataset& dataset, const SlamOptions& options,
-             SlamResult* result, std::string* error) {
+namespace {
+
+bool RunSlamAtOrigin(const Dataset& dataset, const SlamOptions& options,
+                     SlamResult* result, std::string* error) {
   const auto start = std::chrono::steady_clock::now();
   *result = SlamResult();
   ceres::Solver::Options ceres_options;
@@ -846,5 +848,55 @@ bool RunSlam(const Dataset& dataset, const SlamOptions& options,
           .count();
   return true;
 }
+
+// The dataset moved by `offset` in the plane (every position it holds).
+Dataset Translated(const Dataset& dataset, const Eigen::Vector2d& offset) {
+  Dataset moved = dataset;
+  auto move = [&](double* x, double* y) {
+    *x += offset.x();
+    *y += offset.y();
+  };
+  for (PosePrior& p : moved.pose_priors) move(&p.pose.x, &p.pose.y);
+  for (LandmarkPrior& p : moved.landmark_priors) move(&p.x, &p.y);
+  for (TimedPose& p : moved.ground_truth) move(&p.x, &p.y);
+  for (Landmark& l : moved.ground_truth_landmarks) move(&l.x, &l.y);
+  return moved;
+}
+
+}  // namespace
+
+// Solved about the start: Ceres's parameter tolerance is relative to the
+// parameters' size, so a scene 1e9 m from the origin would stop short.
+bool RunSlam(const Dataset& dataset, const SlamOptions& options,
+             SlamResult* result, std::string* error) {
+  Eigen::Vector2d origin = Eigen::Vector2d::Zero();
+  if (!dataset.pose_priors.empty()) {
+    const TimedPose& start = EarliestPosePrior(dataset).pose;
+    origin = Eigen::Vector2d(start.x, start.y);
+  }
+  if (origin.isZero() || !origin.allFinite()) {
+    return RunSlamAtOrigin(dataset, options, result, error);
+  }
+  SlamOptions centred = options;
+  for (TimedPose& p : centred.initial_poses) {
+    p.x -= origin.x();
+    p.y -= origin.y();
+  }
+  for (auto& [id, position] : centred.initial_landmarks) position -= origin;
+  if (!RunSlamAtOrigin(Translated(dataset, -origin), centred, result,
+                       error)) {
+    return false;
+  }
+  for (TimedPose& p : result->trajectory) {
+    p.x += origin.x();
+    p.y += origin.y();
+  }
+  for (Landmark& l : result->landmarks) {
+    l.x += origin.x();
+    l.y += origin.y();
+  }
+  return true;
+}
+
 
 }  // namespace rff

@@ -167,16 +167,16 @@ const AppCase kAppCases[] = {
     // rff_convert.
     {"ConvertUnknownFormat",
      "{bin}/rff_convert --format=kitti --input={dir} --output={dir}/o.rffd",
-     "rff_convert: --format must be plaza or mrclam, got 'kitti'",
+     "rff_convert: error: --format must be plaza or mrclam, got 'kitti'",
      "{dir}/o.rffd"},
     {"ConvertNoInput", "{bin}/rff_convert --format=plaza --output={dir}/o.rffd",
-     "rff_convert: --input=DIR is required", "{dir}/o.rffd"},
+     "rff_convert: error: --input=DIR is required", "{dir}/o.rffd"},
     {"ConvertNoOutput", "{bin}/rff_convert --format=plaza --input={dir}",
-     "rff_convert: --output=OUT.rffd is required", ""},
+     "rff_convert: error: --output=OUT.rffd is required", ""},
     {"ConvertMissingRawFiles",
      "{bin}/rff_convert --format=plaza --input={dir}/none "
      "--output={dir}/o.rffd",
-     "rff_convert: {dir}/none/Plaza1_GT.txt: cannot open for reading",
+     "rff_convert: error: {dir}/none/Plaza1_GT.txt: cannot open for reading",
      "{dir}/o.rffd"},
     {"ConvertUnknownCalibration",
      "{bin}/rff_convert --format=plaza --input={dir} --output={dir}/o.rffd "
@@ -184,11 +184,11 @@ const AppCase kAppCases[] = {
      "unknown Plaza calibration 'cubic' (use linear or none)", "{dir}/o.rffd"},
     {"ConvertMrclamWithoutRobot",
      "{bin}/rff_convert --format=mrclam --input={dir} --output={dir}/o.rffd",
-     "rff_convert: mrclam_robot must be 1..5, got 0", "{dir}/o.rffd"},
+     "rff_convert: error: mrclam_robot must be 1..5, got 0", "{dir}/o.rffd"},
     {"ConvertNegativeGtRate",
      "{bin}/rff_convert --format=mrclam --mrclam_robot=1 --input={dir} "
      "--output={dir}/o.rffd --gt_rate_hz=-1",
-     "rff_convert: gt_rate_hz must be >= 0, got -1", "{dir}/o.rffd"},
+     "rff_convert: error: gt_rate_hz must be >= 0, got -1", "{dir}/o.rffd"},
     {"ConvertNaNSigma",
      "{bin}/rff_convert --format=plaza --input={dir} --output={dir}/o.rffd "
      "--plaza_odom_sigma_xy_floor=nan",
