@@ -411,6 +411,7 @@ std::vector<VarianceGroup> SlamProblem::RowGroups(
 }
 
 std::shared_ptr<ceres::ParameterBlockOrdering> SlamProblem::Ordering() {
+  if (added_.empty()) return nullptr;
   auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
   for (const LandmarkId id : added_) {
     ordering->AddElementToGroup(landmark_block(id), 0);

@@ -167,7 +167,8 @@ class SlamProblem {
 
   // Landmarks in group 0 (eliminated first), trajectory blocks in group 1,
   // the model's shared blocks (a rotation of its mean) in group 2, the range
-  // calibration in group 3.
+  // calibration in group 3. Null without landmarks: Ceres then finds its own
+  // independent set to eliminate.
   std::shared_ptr<ceres::ParameterBlockOrdering> Ordering();
 
  private:

@@ -363,6 +363,14 @@ bool SolveIncremental(const Dataset& dataset, const SlamOptions& options,
   for (const LandmarkPrior& p : dataset.landmark_priors) ids.push_back(p.id);
   for (const Observation& o : dataset.observations) ids.push_back(o.id);
   if (!slam.Begin(ids, error)) return false;
+  // A landmark that the whole run cannot locate never will be: an error now,
+  // not a retry at every update.
+  std::map<LandmarkId, Eigen::Vector2d> locatable;
+  if (!InitializeLandmarks(
+          dataset, [&](double t) { return model->Pose(t); }, &locatable,
+          error)) {
+    return false;
+  }
   ceres::Problem* ceres_problem = slam.problem();
   ChooseLinearSolver(options.solver, *model, &ceres_options, result);
 
@@ -385,20 +393,20 @@ bool SolveIncremental(const Dataset& dataset, const SlamOptions& options,
   int prior_end = 0;  // Trajectory prior terms added for blocks below this.
   std::vector<Observation> pending;  // Of landmarks not located yet.
 
-  const std::vector<Observation>& observations = dataset.observations;
-  for (std::size_t i = 0; i < observations.size(); ++i) {
-    const Observation& o = observations[i];
-    touch(o.t);
-    if (slam.has_landmark(o.id)) {
-      slam.AddObservation(o);
-    } else {
-      pending.push_back(o);
-    }
-    const bool last = i + 1 == observations.size();
-    if ((i + 1) % incremental.every != 0 && !last) continue;
-
+  double data_end = -std::numeric_limits<double>::infinity();
+  for (const Observation& o : dataset.observations) {
+    data_end = std::max(data_end, o.t);
+  }
+  for (const PreintegratedOdometry& o : odometry) {
+    data_end = std::max(data_end, o.t1);
+  }
+  for (const PosePrior& p : dataset.pose_priors) {
+    data_end = std::max(data_end, p.pose.t);
+  }
+  // Adds the priors and odometry up to `now` and the landmarks that can be
+  // located, then solves the blocks in use.
+  auto solve_update = [&](double now, int num_measurements) {
     const auto start = std::chrono::steady_clock::now();
-    const double now = o.t;
     for (; next_prior < dataset.pose_priors.size() &&
            dataset.pose_priors[next_prior].pose.t <= now;
          ++next_prior) {
@@ -443,8 +451,8 @@ bool SolveIncremental(const Dataset& dataset, const SlamOptions& options,
     prior_end = used_end;
 
     IncrementalUpdate update;
-    update.t = now;
-    update.num_measurements = static_cast<int>(i + 1);
+    update.t = std::min(now, data_end);
+    update.num_measurements = num_measurements;
     for (int b = 0; b < model->num_blocks(); ++b) {
       const bool active = in_use(b) && (incremental.lag <= 0.0 ||
                                         touched[b] >= now - incremental.lag);
@@ -464,7 +472,7 @@ bool SolveIncremental(const Dataset& dataset, const SlamOptions& options,
     }
     ceres::Solve(ceres_options, ceres_problem, &result->summary);
     if (!CheckSolve(result->summary, &slam, error)) {
-      *error = "update at t = " + FormatNumber(now) + ": " + *error;
+      *error = "update at t = " + FormatNumber(update.t) + ": " + *error;
       return false;
     }
     update.iterations = static_cast<int>(result->summary.iterations.size());
@@ -476,6 +484,29 @@ bool SolveIncremental(const Dataset& dataset, const SlamOptions& options,
     VLOG(1) << "update at t = " << now << ": " << update.num_measurements
             << " measurements, " << update.active_blocks << " active blocks, "
             << update.iterations << " iterations, " << update.seconds << " s";
+    return true;
+  };
+  const std::vector<Observation>& observations = dataset.observations;
+  for (std::size_t i = 0; i < observations.size(); ++i) {
+    const Observation& o = observations[i];
+    touch(o.t);
+    if (slam.has_landmark(o.id)) {
+      slam.AddObservation(o);
+    } else {
+      pending.push_back(o);
+    }
+    if ((i + 1) % incremental.every != 0) continue;
+    if (!solve_update(o.t, static_cast<int>(i + 1))) return false;
+  }
+  // The data after the last update (the last observations, odometry and
+  // priors after them), or all of it when no update ran.
+  if (result->updates.empty() || next_odometry < odometry.size() ||
+      next_prior < dataset.pose_priors.size() ||
+      observations.size() % incremental.every != 0) {
+    if (!solve_update(std::numeric_limits<double>::infinity(),
+                      static_cast<int>(observations.size()))) {
+      return false;
+    }
   }
   if (!pending.empty()) {
     *error = "landmark " + std::to_string(pending.front().id) +
@@ -883,8 +914,7 @@ bool RunSlam(const Dataset& dataset, const SlamOptions& options,
     p.y -= origin.y();
   }
   for (auto& [id, position] : centred.initial_landmarks) position -= origin;
-  if (!RunSlamAtOrigin(Translated(dataset, -origin), centred, result,
-                       error)) {
+  if (!RunSlamAtOrigin(Translated(dataset, -origin), centred, result, error)) {
     return false;
   }
   for (TimedPose& p : result->trajectory) {
@@ -897,6 +927,5 @@ bool RunSlam(const Dataset& dataset, const SlamOptions& options,
   }
   return true;
 }
-
 
 }  // namespace rff
