@@ -148,9 +148,9 @@ std::unique_ptr<FeatureTrajectory> FeatureTrajectory::Create(
     FeatureMapOptions map_options;
     map_options.family = options.family;
     // Each segment's maps cover its extent and half the overlap each side.
-    map_options.window_begin = s.begin - (k > 0 ? 0.5 * model->overlap_ : 0.0);
+    map_options.window_begin = k > 0 ? -0.5 * model->overlap_ : 0.0;
     map_options.window_end =
-        s.end + (k + 1 < num_segments ? 0.5 * model->overlap_ : 0.0);
+        segment + (k + 1 < num_segments ? 0.5 * model->overlap_ : 0.0);
     map_options.num_features = options.num_position_features;
     map_options.seed = options.seed + 2 * k;
     s.position_map =
@@ -199,11 +199,11 @@ const std::vector<FeatureTrajectory::Features>& FeatureTrajectory::FeaturesAt(
     const Segment& seg = segments_[s];
     auto position =
         std::make_shared<Eigen::VectorXd>(seg.position_map->num_features());
-    seg.position_map->Evaluate(tau, position->data(), nullptr);
+    seg.position_map->Evaluate(tau - seg.begin, position->data(), nullptr);
     *position *= weight;
     auto heading =
         std::make_shared<Eigen::VectorXd>(seg.heading_map->num_features());
-    seg.heading_map->Evaluate(tau, heading->data(), nullptr);
+    seg.heading_map->Evaluate(tau - seg.begin, heading->data(), nullptr);
     *heading *= weight;
     features.push_back({s, position, heading});
   }

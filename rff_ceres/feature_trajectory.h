@@ -111,6 +111,8 @@ class FeatureTrajectory : public TrajectoryModel {
   struct Segment {
     double begin = 0.0;  // Nominal extent, relative to the origin.
     double end = 0.0;
+    // Of times relative to `begin`: the feature maps keep their precision
+    // however long the run.
     std::unique_ptr<FeatureMap> position_map, heading_map;
   };
   // Blend-weighted features of the (one or two) segments active at a time.

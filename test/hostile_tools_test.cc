@@ -1,0 +1,253 @@
+// Hostile flags, sizes and paths against the built tools: each case has one
+// expected outcome. A refused case exits 1 with a message naming the cause,
+// writes no output and leaves every input byte for byte as it was; an
+// accepted one exits 0 with finite output.
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "gmock/gmock.h"
+#include "gtest/gtest.h"
+#include "rff_ceres/io/tum_io.h"
+#include "test/app_runner.h"
+#include "test/test_files.h"
+
+namespace rff {
+namespace {
+
+using testing::Expand;
+using testing::HasNonFiniteToken;
+using ::testing::HasSubstr;
+using testing::ReadFile;
+using testing::RunCommand;
+using testing::RunResult;
+using testing::ValidDataset;
+using testing::WriteFile;
+
+struct HostileCase {
+  const char* name;
+  const char* command;
+  const char* message;  // Expected part of the output.
+  const char* output;   // Must not exist afterwards ("" for none).
+};
+void PrintTo(const HostileCase& c, std::ostream* out) { *out << c.name; }
+
+// The files every case may use, in {dir}.
+void WriteInputs(const std::string& dir) {
+  const std::string valid = ValidDataset(0.0);
+  WriteFile(dir + "/valid.rffd", valid);
+  WriteFile(dir + "/self.flags", "--flagfile=" + dir + "/self.flags\n");
+  WriteFile(dir + "/a.flags", "--flagfile=" + dir + "/b.flags\n");
+  WriteFile(dir + "/b.flags", "--flagfile=" + dir + "/a.flags\n");
+  WriteFile(dir + "/typo.flags", "--num_featurs=12\n");
+  std::string tiny = valid;
+  for (std::size_t at = tiny.find("0.05 0.05 0.01"); at != std::string::npos;
+       at = tiny.find("0.05 0.05 0.01", at)) {
+    tiny.replace(at, 14, "1e-100 1e-100 1e-100");
+  }
+  WriteFile(dir + "/tiny_odometry_sigma.rffd", tiny);
+  WriteFile(dir + "/overflowing_odometry.rffd",
+            "RFFD 1\nPRIOR_POSE 0 0 0 0 1 1\n"
+            "ODOM 0 1 1e308 0 0 1 1 1\nODOM 1 2 1e308 0 0 1 1 1\n"
+            "GT_POSE 2 0 0 0\n");
+  WriteFile(dir + "/far_truth.rffd",
+            "RFFD 1\nPRIOR_POSE 0 0 0 0 1 1\nGT_POSE 0 -1e308 0 0\n");
+  WriteFile(dir + "/far.tum", "0 1e308 0 0 0 0 0 1\n");
+  std::filesystem::create_directories(dir + "/raw");
+  WriteFile(dir + "/raw/Plaza1_GT.txt", "raw ground truth\n");
+}
+
+class HostileToolTest : public ::testing::TestWithParam<HostileCase> {};
+
+TEST_P(HostileToolTest, ExitsOneNamingTheCauseAndWritesNothing) {
+  const std::string dir = testing::TempDir("hostile_tools_test");
+  WriteInputs(dir);
+  std::vector<std::pair<std::string, std::string>> inputs;
+  for (const auto& entry : std::filesystem::recursive_directory_iterator(dir)) {
+    if (entry.is_regular_file()) {
+      inputs.emplace_back(entry.path().string(), ReadFile(entry.path()));
+    }
+  }
+  const RunResult run = RunCommand(Expand(GetParam().command, dir));
+  EXPECT_EQ(run.exit_code, 1) << run.output;
+  EXPECT_THAT(run.output, HasSubstr(Expand(GetParam().message, dir)));
+  const std::string output = Expand(GetParam().output, dir);
+  if (!output.empty()) EXPECT_FALSE(std::filesystem::exists(output));
+  int files = 0;
+  for (const auto& entry : std::filesystem::recursive_directory_iterator(dir)) {
+    files += entry.is_regular_file();
+  }
+  EXPECT_EQ(files, static_cast<int>(inputs.size())) << "a file was written";
+  for (const auto& [path, bytes] : inputs) {
+    EXPECT_EQ(ReadFile(path), bytes) << path << " changed";
+  }
+}
+
+#define SLAM "{bin}/rff_slam --dataset={dir}/valid.rffd "
+#define OUT " --output_trajectory={dir}/out.tum"
+
+const HostileCase kHostileCases[] = {
+    // Data loss: an output on an input, two outputs on one path, and output
+    // directories checked before any work.
+    {"SlamOutputOnDataset", SLAM "--output_trajectory={dir}/valid.rffd",
+     "rff_slam: error: --output_trajectory={dir}/valid.rffd: the same file as "
+     "the input --dataset={dir}/valid.rffd; refusing to overwrite an input",
+     ""},
+    {"SlamLandmarksOnDatasetOtherSpelling",
+     SLAM "--output_landmarks={dir}/./valid.rffd",
+     "--output_landmarks={dir}/./valid.rffd: the same file as the input", ""},
+    {"SlamTwoOutputsOnOnePath",
+     SLAM "--output_trajectory={dir}/o.txt --summary_json={dir}/o.txt",
+     "--summary_json={dir}/o.txt: the same file as the output "
+     "--output_trajectory={dir}/o.txt; each output needs its own path",
+     "{dir}/o.txt"},
+    {"SlamBadLandmarkDirectoryWritesNoTrajectory",
+     SLAM OUT " --output_landmarks={dir}/no/l.txt",
+     "--output_landmarks={dir}/no/l.txt: directory '{dir}/no' does not exist",
+     "{dir}/out.tum"},
+    {"ConvertOverRawFile",
+     "{bin}/rff_convert --format=plaza --input={dir}/raw "
+     "--output={dir}/raw/Plaza1_GT.txt",
+     "rff_convert: error: --output={dir}/raw/Plaza1_GT.txt: a file of the "
+     "input directory --input={dir}/raw; refusing to overwrite an input",
+     ""},
+    {"DeadReckoningOutputOnDataset",
+     "{bin}/rff_dead_reckoning --dataset={dir}/valid.rffd "
+     "--output_trajectory={dir}/valid.rffd",
+     "--output_trajectory={dir}/valid.rffd: the same file as the input "
+     "--dataset={dir}/valid.rffd",
+     ""},
+    {"EvaluateJsonOnTrajectory",
+     "{bin}/rff_evaluate --dataset={dir}/valid.rffd --trajectory={dir}/far.tum "
+     "--json={dir}/far.tum",
+     "--json={dir}/far.tum: the same file as the input --trajectory="
+     "{dir}/far.tum",
+     ""},
+    {"SimulateOutputIsDirectory", "{bin}/rff_simulate --output={dir}",
+     "rff_simulate: error: --output={dir}: is a directory; give a file name",
+     ""},
+    // Sizes no machine can solve.
+    {"Features30000", SLAM "--num_features=30000" OUT,
+     "num_features must be in [0, 2048] (0: from the capacity rule), got "
+     "30000",
+     "{dir}/out.tum"},
+    {"Features65535", SLAM "--num_features=65535" OUT,
+     "num_features must be in [0, 2048]", "{dir}/out.tum"},
+    {"HeadingFeatures65536",
+     SLAM "--num_features=10 --num_heading_features=65536" OUT,
+     "num_heading_features must be in [0, 2048] (0: from the capacity rule), "
+     "got 65536",
+     "{dir}/out.tum"},
+    {"HeadingFeaturesWithAutoCapacity", SLAM "--num_heading_features=50" OUT,
+     "num_heading_features 50 needs num_features > 0", "{dir}/out.tum"},
+    {"SegmentOverflowingInt", SLAM "--segment_length=1e-10" OUT,
+     "segment_length 1e-10 s cuts the run's 1 s into more than 100000 "
+     "segments",
+     "{dir}/out.tum"},
+    {"SegmentsOverTheRun",
+     SLAM "--segment_length=1e-5 --linear_solver=SPARSE_NORMAL_CHOLESKY" OUT,
+     "segment_length 1e-05 s cuts the run's 10 s into more than 100000 "
+     "segments",
+     "{dir}/out.tum"},
+    {"OuterRoundsForever", SLAM "--outer_rounds=2147483647" OUT,
+     "outer_rounds must be in [0, 100], got 2147483647", "{dir}/out.tum"},
+    {"SubsetPreconditioner",
+     SLAM "--preconditioner=SUBSET --linear_solver=ITERATIVE_SCHUR" OUT,
+     "preconditioner SUBSET is not supported", "{dir}/out.tum"},
+    {"LengthscaleBeyondDoubles", SLAM "--lengthscale=1e308" OUT,
+     "kernel lengthscale must be at most 1e+12, got 1e+308", "{dir}/out.tum"},
+    {"WnoaLengthscaleNaN", SLAM "--prior=wnoa --lengthscale=nan" OUT,
+     "kernel lengthscale must be positive and finite, got nan",
+     "{dir}/out.tum"},
+    {"PreintegrationNaN", SLAM "--max_preintegration_seconds=nan" OUT,
+     "max_preintegration_seconds must be finite and >= 0, got nan",
+     "{dir}/out.tum"},
+    {"PreintegrationNegative", SLAM "--max_preintegration_seconds=-1" OUT,
+     "max_preintegration_seconds must be finite and >= 0, got -1",
+     "{dir}/out.tum"},
+    {"ConvertPriorSigmaNaN",
+     "{bin}/rff_convert --format=plaza --input={dir}/raw --output={dir}/o.rffd "
+     "--prior_sigma_xy=nan",
+     "prior_sigma_xy must be > 0, got nan", "{dir}/o.rffd"},
+    // Flagfiles.
+    {"SlamSelfIncludingFlagfile", SLAM "--flagfile={dir}/self.flags" OUT,
+     "rff_slam: error: --flagfile={dir}/self.flags: includes itself",
+     "{dir}/out.tum"},
+    {"ExperimentSelfIncludingFlagfile",
+     "{bin}/rff_experiment --flagfile={dir}/self.flags --out_dir={dir}/exp",
+     "rff_experiment: error: --flagfile={dir}/self.flags: includes itself",
+     "{dir}/exp"},
+    {"SlamFlagfileCycle", SLAM "--flagfile={dir}/a.flags" OUT,
+     "--flagfile={dir}/a.flags: includes itself through other flagfiles",
+     "{dir}/out.tum"},
+    {"SlamTypoInFlagfile", SLAM "--flagfile={dir}/typo.flags" OUT,
+     "rff_slam: error: {dir}/typo.flags:1: unknown flag '--num_featurs'",
+     "{dir}/out.tum"},
+    // Numbers that overflow and messages that name the cause.
+    {"TinyOdometrySigma",
+     "{bin}/rff_slam --dataset={dir}/tiny_odometry_sigma.rffd" OUT,
+     "odometry from t = 0 to 1: its covariance cannot be inverted in double "
+     "precision (sigmas too small)",
+     "{dir}/out.tum"},
+    {"DeadReckoningOverflow",
+     "{bin}/rff_dead_reckoning --dataset={dir}/overflowing_odometry.rffd "
+     "--output_trajectory={dir}/out.tum",
+     "overflows double precision", "{dir}/out.tum"},
+    {"EvaluateOverflow",
+     "{bin}/rff_evaluate --dataset={dir}/far_truth.rffd "
+     "--trajectory={dir}/far.tum --json={dir}/out.json",
+     "the APE translation overflows double precision", "{dir}/out.json"},
+    {"DirectoryAsDataset", "{bin}/rff_slam --dataset={dir}" OUT,
+     "rff_slam: error: {dir}: cannot open for reading: is a directory, not a "
+     "file",
+     "{dir}/out.tum"},
+};
+INSTANTIATE_TEST_SUITE_P(Cases, HostileToolTest,
+                         ::testing::ValuesIn(kHostileCases),
+                         [](const ::testing::TestParamInfo<HostileCase>& info) {
+                           return std::string(info.param.name);
+                         });
+
+// Accepted: the run without range or bearing measurements in incremental
+// mode is solved (it used to exit 0 with an unsolved trajectory).
+TEST(HostileToolAcceptTest, IncrementalOdometryOnlyIsSolved) {
+  const std::string dir = testing::TempDir("hostile_tools_test");
+  WriteFile(dir + "/odometry.rffd",
+            "RFFD 1\nPRIOR_POSE 0 0 0 0 0.1 0.01\n"
+            "ODOM 0 1 1 0 0 0.05 0.05 0.01\nODOM 1 2 1 0 0 0.05 0.05 0.01\n"
+            "GT_POSE 0 0 0 0\nGT_POSE 1 1 0 0\nGT_POSE 2 2 0 0\n");
+  const RunResult run = RunCommand(Expand(
+      "{bin}/rff_slam --dataset={dir}/odometry.rffd --incremental_every=1 "
+      "--output_trajectory={dir}/out.tum",
+      dir));
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_THAT(run.output, HasSubstr("CONVERGENCE"));
+  std::vector<TimedPose> poses;
+  std::string error;
+  ASSERT_TRUE(ReadTum(dir + "/out.tum", &poses, &error)) << error;
+  ASSERT_EQ(poses.size(), 3u);
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_NEAR(poses[k].x, k, 1e-6);
+    EXPECT_NEAR(poses[k].y, 0.0, 1e-6);
+  }
+}
+
+// Accepted: two observations 9e5 s apart with a stray ground-truth pose
+// beyond them solve in seconds, to finite numbers.
+TEST(HostileToolAcceptTest, ObservationsFarApartInTimeSolve) {
+  const std::string dir = testing::TempDir("hostile_tools_test");
+  WriteFile(dir + "/gap.rffd", ValidDataset(0.0) +
+                                   "RANGE_BEARING 900000 1 5 0.1 0.1 0.02\n"
+                                   "GT_POSE 1800000 0 0 0\n");
+  for (const char* prior : {"rff", "wnoa"}) {
+    const RunResult run = RunCommand(
+        Expand(std::string("{bin}/rff_slam --dataset={dir}/gap.rffd --prior=") +
+                   prior + " --output_trajectory={dir}/out.tum",
+               dir));
+    ASSERT_EQ(run.exit_code, 0) << prior << ": " << run.output;
+    EXPECT_FALSE(HasNonFiniteToken(ReadFile(dir + "/out.tum"))) << prior;
+  }
+}
+
+}  // namespace
+}  // namespace rff

@@ -1,0 +1,75 @@
+#include "rff_ceres/io/flagfile_check.h"
+
+#include <string>
+#include <vector>
+
+#include "gtest/gtest.h"
+#include "test/test_files.h"
+
+namespace rff {
+namespace {
+
+using testing::TempDir;
+using testing::WriteFile;
+
+bool Known(const std::string& name) {
+  return name == "num_features" || name == "prior" || name == "evaluate" ||
+         name == "noevaluate";
+}
+
+std::string Check(const std::vector<std::string>& args) {
+  std::string error;
+  return CheckFlagfiles(args, Known, &error) ? "ok" : error;
+}
+
+TEST(FlagfileCheckTest, AcceptsCommentsBlanksAndKnownFlags) {
+  const std::string dir = TempDir("FlagfileCheckTest");
+  WriteFile(dir + "/a.flags",
+            "# a comment\n\n  --prior=wnoa\n-num_features=12\n--noevaluate\n");
+  EXPECT_EQ(Check({"--flagfile=" + dir + "/a.flags"}), "ok");
+  EXPECT_EQ(Check({"--flagfile", dir + "/a.flags"}), "ok");
+  EXPECT_EQ(Check({"--prior=rff"}), "ok");
+}
+
+TEST(FlagfileCheckTest, AnUnknownFlagInsideIsAnError) {
+  const std::string dir = TempDir("FlagfileCheckTest");
+  WriteFile(dir + "/typo.flags", "--prior=wnoa\n--num_featurs=12\n");
+  EXPECT_EQ(Check({"--flagfile=" + dir + "/typo.flags"}),
+            dir + "/typo.flags:2: unknown flag '--num_featurs'");
+  WriteFile(dir + "/bare.flags", "num_features=12\n");
+  EXPECT_EQ(
+      Check({"--flagfile=" + dir + "/bare.flags"}),
+      dir + "/bare.flags:1: expected --name=value, got 'num_features=12'");
+}
+
+TEST(FlagfileCheckTest, SelfInclusionIsAnError) {
+  const std::string dir = TempDir("FlagfileCheckTest");
+  WriteFile(dir + "/self.flags", "--flagfile=" + dir + "/self.flags\n");
+  EXPECT_EQ(Check({"--flagfile=" + dir + "/self.flags"}),
+            "--flagfile=" + dir + "/self.flags: includes itself");
+  WriteFile(dir + "/a.flags", "--flagfile=" + dir + "/b.flags\n");
+  WriteFile(dir + "/b.flags", "--prior=rff\n--flagfile=" + dir + "/a.flags\n");
+  EXPECT_EQ(Check({"--flagfile=" + dir + "/a.flags"}),
+            "--flagfile=" + dir +
+                "/a.flags: includes itself through other "
+                "flagfiles");
+}
+
+TEST(FlagfileCheckTest, TheSameFileTwiceWithoutACycleIsFine) {
+  const std::string dir = TempDir("FlagfileCheckTest");
+  WriteFile(dir + "/common.flags", "--prior=rff\n");
+  WriteFile(dir + "/a.flags", "--flagfile=" + dir + "/common.flags\n");
+  EXPECT_EQ(Check({"--flagfile=" + dir + "/a.flags," + dir + "/common.flags"}),
+            "ok");
+}
+
+TEST(FlagfileCheckTest, AMissingFileOrDirectoryIsAnError) {
+  const std::string dir = TempDir("FlagfileCheckTest");
+  EXPECT_EQ(Check({"--flagfile=" + dir + "/none.flags"}),
+            "--flagfile=" + dir + "/none.flags: cannot open for reading");
+  EXPECT_EQ(Check({"--flagfile=" + dir}),
+            "--flagfile=" + dir + ": is a directory");
+}
+
+}  // namespace
+}  // namespace rff

@@ -1,0 +1,154 @@
+#include "rff_ceres/io/output_file.h"
+
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <csignal>
+#include <filesystem>
+#include <string>
+
+#include "gtest/gtest.h"
+#include "test/test_files.h"
+
+namespace rff {
+namespace {
+
+using testing::ReadFile;
+using testing::TempDir;
+using testing::WriteFile;
+
+// Names in `dir` other than the given ones (left-over temporary files).
+int CountFiles(const std::string& dir) {
+  int count = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+    (void)entry;
+    ++count;
+  }
+  return count;
+}
+
+TEST(OutputFileTest, CommitReplacesTheFileWhole) {
+  const std::string dir = TempDir("OutputFileTest");
+  WriteFile(dir + "/out.txt", "old\n");
+  OutputFile file(dir + "/out.txt");
+  std::string error;
+  ASSERT_TRUE(file.Open(&error)) << error;
+  file.stream() << "new\n";
+  // Until the commit a reader sees the old file.
+  EXPECT_EQ(ReadFile(dir + "/out.txt"), "old\n");
+  ASSERT_TRUE(file.Commit(&error)) << error;
+  EXPECT_EQ(ReadFile(dir + "/out.txt"), "new\n");
+  EXPECT_EQ(CountFiles(dir), 1);
+}
+
+TEST(OutputFileTest, AnUncommittedFileLeavesTheOldOneAndNoTemporary) {
+  const std::string dir = TempDir("OutputFileTest");
+  WriteFile(dir + "/out.txt", "old\n");
+  {
+    OutputFile file(dir + "/out.txt");
+    std::string error;
+    ASSERT_TRUE(file.Open(&error)) << error;
+    file.stream() << "half a li";
+  }
+  EXPECT_EQ(ReadFile(dir + "/out.txt"), "old\n");
+  EXPECT_EQ(CountFiles(dir), 1);
+}
+
+// A write that fails midway (here the file-size limit, as a full disk
+// would) reports the error and leaves the previous file as it was.
+TEST(OutputFileTest, AWriteErrorKeepsThePreviousFile) {
+  const std::string dir = TempDir("OutputFileTest");
+  WriteFile(dir + "/out.txt", "old\n");
+  const pid_t child = fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    std::signal(SIGXFSZ, SIG_IGN);
+    const rlimit limit = {4096, 4096};
+    setrlimit(RLIMIT_FSIZE, &limit);
+    OutputFile file(dir + "/out.txt");
+    std::string error;
+    if (!file.Open(&error)) _exit(2);
+    for (int i = 0; i < 100000; ++i) file.stream() << "0123456789\n";
+    _exit(file.Commit(&error) ? 0 : 1);
+  }
+  int status = 0;
+  ASSERT_EQ(waitpid(child, &status, 0), child);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 1);
+  EXPECT_EQ(ReadFile(dir + "/out.txt"), "old\n");
+  EXPECT_EQ(CountFiles(dir), 1);
+}
+
+TEST(OutputFileTest, OpenFailsForAMissingDirectory) {
+  const std::string dir = TempDir("OutputFileTest");
+  OutputFile file(dir + "/no/out.txt");
+  std::string error;
+  EXPECT_FALSE(file.Open(&error));
+  EXPECT_EQ(error, dir +
+                       "/no/out.txt: cannot open for writing: No such file "
+                       "or directory");
+}
+
+TEST(CheckOutputPathsTest, RefusesAnInputUnderAnySpelling) {
+  const std::string dir = TempDir("CheckOutputPathsTest");
+  WriteFile(dir + "/in.rffd", "RFFD 1\n");
+  std::filesystem::create_hard_link(dir + "/in.rffd", dir + "/link.rffd");
+  std::string error;
+  for (const std::string& output :
+       {dir + "/in.rffd", dir + "/./in.rffd",
+        dir + "/../" + std::filesystem::path(dir).filename().string() +
+            "/in.rffd",
+        dir + "/link.rffd"}) {
+    EXPECT_FALSE(CheckOutputPaths({{"--dataset", dir + "/in.rffd"}},
+                                  {{"--output_trajectory", output}}, &error))
+        << output;
+    EXPECT_EQ(error, "--output_trajectory=" + output +
+                         ": the same file as the input --dataset=" + dir +
+                         "/in.rffd; refusing to overwrite an input");
+  }
+}
+
+TEST(CheckOutputPathsTest, RefusesTwoOutputsOnOnePath) {
+  const std::string dir = TempDir("CheckOutputPathsTest");
+  std::string error;
+  EXPECT_FALSE(CheckOutputPaths(
+      {}, {{"--a", dir + "/o.txt"}, {"--b", ""}, {"--c", dir + "/./o.txt"}},
+      &error));
+  EXPECT_EQ(error, "--c=" + dir + "/./o.txt: the same file as the output --a=" +
+                       dir + "/o.txt; each output needs its own path");
+}
+
+TEST(CheckOutputPathsTest, RefusesAFileOfAnInputDirectory) {
+  const std::string dir = TempDir("CheckOutputPathsTest");
+  std::filesystem::create_directories(dir + "/raw");
+  WriteFile(dir + "/raw/GT.txt", "1 2 3\n");
+  std::string error;
+  EXPECT_FALSE(CheckOutputPaths({{"--input", dir + "/raw"}},
+                                {{"--output", dir + "/raw/GT.txt"}}, &error));
+  EXPECT_EQ(error, "--output=" + dir +
+                       "/raw/GT.txt: a file of the input directory --input=" +
+                       dir + "/raw; refusing to overwrite an input");
+  // A new file beside the raw ones overwrites nothing.
+  EXPECT_TRUE(CheckOutputPaths({{"--input", dir + "/raw"}},
+                               {{"--output", dir + "/raw/new.rffd"}}, &error))
+      << error;
+}
+
+TEST(CheckOutputPathsTest, ChecksTheDirectoryBeforeAnyWork) {
+  const std::string dir = TempDir("CheckOutputPathsTest");
+  WriteFile(dir + "/file", "");
+  std::string error;
+  EXPECT_FALSE(CheckOutputPaths({}, {{"--o", dir + "/no/o.txt"}}, &error));
+  EXPECT_EQ(error, "--o=" + dir + "/no/o.txt: directory '" + dir +
+                       "/no' does not exist");
+  EXPECT_FALSE(CheckOutputPaths({}, {{"--o", dir + "/file/o.txt"}}, &error));
+  EXPECT_EQ(error, "--o=" + dir + "/file/o.txt: directory '" + dir +
+                       "/file' is not a directory");
+  EXPECT_FALSE(CheckOutputPaths({}, {{"--o", dir}}, &error));
+  EXPECT_EQ(error, "--o=" + dir + ": is a directory; give a file name");
+  EXPECT_TRUE(CheckOutputPaths({}, {{"--o", dir + "/o.txt"}}, &error)) << error;
+}
+
+}  // namespace
+}  // namespace rff
