@@ -5,6 +5,7 @@
 #include <cmath>
 #include <fstream>
 #include <limits>
+#include <set>
 
 #include "ceres/types.h"
 #include "glog/logging.h"
@@ -706,6 +707,19 @@ bool RunSlamAtOrigin(const Dataset& dataset, const SlamOptions& options,
         "the dataset has no observations and no odometry: nothing to "
         "estimate";
     return false;
+  }
+  if (options.compute_covariance) {
+    std::set<LandmarkId> ids;
+    for (const LandmarkPrior& p : dataset.landmark_priors) ids.insert(p.id);
+    for (const Observation& o : dataset.observations) ids.insert(o.id);
+    if (ids.size() > kMaxCovarianceLandmarks) {
+      *error = "the covariance of " + std::to_string(ids.size()) +
+               " landmarks is more than the " +
+               std::to_string(kMaxCovarianceLandmarks) +
+               " supported (each costs a solve of the whole system); solve "
+               "without --output_covariance";
+      return false;
+    }
   }
 
   // The start (heading, pilot) may come from the data.

@@ -53,6 +53,11 @@ void WriteInputs(const std::string& dir) {
   WriteFile(dir + "/far_truth.rffd",
             "RFFD 1\nPRIOR_POSE 0 0 0 0 1 1\nGT_POSE 0 -1e308 0 0\n");
   WriteFile(dir + "/far.tum", "0 1e308 0 0 0 0 0 1\n");
+  std::string many = valid;
+  for (int id = 100; id < 100 + 10000; ++id) {
+    many += "PRIOR_LANDMARK " + std::to_string(id) + " 0 0 1\n";
+  }
+  WriteFile(dir + "/many_landmarks.rffd", many);
   std::filesystem::create_directories(dir + "/raw");
   WriteFile(dir + "/raw/Plaza1_GT.txt", "raw ground truth\n");
 }
@@ -197,6 +202,11 @@ const HostileCase kHostileCases[] = {
      "{bin}/rff_evaluate --dataset={dir}/far_truth.rffd "
      "--trajectory={dir}/far.tum --json={dir}/out.json",
      "the APE translation overflows double precision", "{dir}/out.json"},
+    {"CovarianceOfTooManyLandmarks",
+     "{bin}/rff_slam --dataset={dir}/many_landmarks.rffd" OUT
+     " --output_covariance={dir}/out.cov",
+     "the covariance of 10003 landmarks is more than the 10000 supported",
+     "{dir}/out.cov"},
     {"DirectoryAsDataset", "{bin}/rff_slam --dataset={dir}" OUT,
      "rff_slam: error: {dir}: cannot open for reading: is a directory, not a "
      "file",
