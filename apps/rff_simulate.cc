@@ -129,9 +129,11 @@ int main(int argc, char** argv) {
   }
   if (all || Given("sigma_range")) options.sigma_range = FLAGS_sigma_range;
   if (all || Given("sigma_bearing_deg")) {
-    if (!(std::isfinite(FLAGS_sigma_bearing_deg) &&
-          FLAGS_sigma_bearing_deg > 0.0)) {
-      return Fail("--sigma_bearing_deg must be finite and > 0, got " +
+    // Checked in the unit given: the library's bound is in radians.
+    constexpr double kMaxSigmaBearingDeg = 360.0;
+    if (!(FLAGS_sigma_bearing_deg > 0.0 &&
+          FLAGS_sigma_bearing_deg <= kMaxSigmaBearingDeg)) {
+      return Fail("--sigma_bearing_deg must be in (0, 360], got " +
                   rff::FormatNumber(FLAGS_sigma_bearing_deg));
     }
     options.sigma_bearing = FLAGS_sigma_bearing_deg * kDegree;

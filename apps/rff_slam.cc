@@ -27,7 +27,7 @@ DEFINE_string(output_landmarks, "", "Write the landmarks here (.landmarks).");
 DEFINE_string(output_covariance, "",
               "Write the covariance of each output pose here (t sxx sxy sxt "
               "syy syt stt per line); the landmarks file then carries "
-              "sxx sxy syy.");
+              "sxx sxy syy. At most 10000 landmarks.");
 DEFINE_string(summary_json, "", "Write the solve summary here (JSON).");
 DEFINE_bool(fail_on_suspect, false,
             "Exit with status 3 when the quality verdict is 'suspect' (the "

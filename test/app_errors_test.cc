@@ -216,7 +216,7 @@ const AppCase kAppCases[] = {
      "sigma_range must be finite and > 0", "{dir}/s.rffd"},
     {"SimulateNaNBearingSigma",
      "{bin}/rff_simulate --output={dir}/s.rffd --sigma_bearing_deg=nan",
-     "--sigma_bearing_deg must be finite and > 0, got nan", "{dir}/s.rffd"},
+     "--sigma_bearing_deg must be in (0, 360], got nan", "{dir}/s.rffd"},
     {"SimulateZeroFieldOfView",
      "{bin}/rff_simulate --output={dir}/s.rffd --field_of_view_deg=0",
      "--field_of_view_deg must be in (0, 360], got 0", "{dir}/s.rffd"},

@@ -207,6 +207,11 @@ const HostileCase kHostileCases[] = {
      " --output_covariance={dir}/out.cov",
      "the covariance of 10003 landmarks is more than the 10000 supported",
      "{dir}/out.cov"},
+    {"BearingSigmaInDegreesStaysInDegrees",
+     "{bin}/rff_simulate --output={dir}/s.rffd --sigma_bearing_deg=1e308",
+     "rff_simulate: error: --sigma_bearing_deg must be in (0, 360], got "
+     "1e+308",
+     "{dir}/s.rffd"},
     {"DirectoryAsDataset", "{bin}/rff_slam --dataset={dir}" OUT,
      "rff_slam: error: {dir}: cannot open for reading: is a directory, not a "
      "file",
@@ -257,6 +262,34 @@ TEST(HostileToolAcceptTest, ObservationsFarApartInTimeSolve) {
     ASSERT_EQ(run.exit_code, 0) << prior << ": " << run.output;
     EXPECT_FALSE(HasNonFiniteToken(ReadFile(dir + "/out.tum"))) << prior;
   }
+}
+
+// Accepted: errors whose squares overflow (1e200 m) are still reported, in
+// valid JSON with finite numbers.
+TEST(HostileToolAcceptTest, ErrorsWhoseSquaresOverflowAreFinite) {
+  const std::string dir = testing::TempDir("hostile_tools_test");
+  WriteFile(dir + "/truth.rffd",
+            "RFFD 1\nPRIOR_POSE 0 0 0 0 1 1\nGT_POSE 0 0 0 0\n"
+            "GT_POSE 1 0 0 0\n");
+  WriteFile(dir + "/far.tum", "0 1e200 0 0 0 0 0 1\n1 -1e200 0 0 0 0 0 1\n");
+  const RunResult run =
+      RunCommand(Expand("{bin}/rff_evaluate --dataset={dir}/truth.rffd "
+                        "--trajectory={dir}/far.tum --json={dir}/out.json",
+                        dir));
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const std::string json = ReadFile(dir + "/out.json");
+  EXPECT_FALSE(HasNonFiniteToken(json)) << json;
+  EXPECT_THAT(json, HasSubstr("1e+200"));
+}
+
+// Accepted: segments of 1 ms over a 10 s run (10000 segments) solve.
+TEST(HostileToolAcceptTest, MillisecondSegmentsSolve) {
+  const std::string dir = testing::TempDir("hostile_tools_test");
+  WriteFile(dir + "/valid.rffd", ValidDataset(0.0));
+  const RunResult run =
+      RunCommand(Expand(SLAM "--segment_length=1e-3" OUT, dir));
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_FALSE(HasNonFiniteToken(ReadFile(dir + "/out.tum")));
 }
 
 }  // namespace
