@@ -47,9 +47,9 @@ DEFINE_int32(num_features, 0,
              "Features per coordinate of x and y (D) per segment; 0 (auto): "
              "D, the segment length and the overlap follow the lengthscales "
              "so that the motion the basis misses stays below 5 cm and "
-             "0.005 rad. At most 2048.");
+             "0.005 rad. At most 1024.");
 DEFINE_int32(num_heading_features, 0,
-             "Features of theta (0: --num_features). At most 2048.");
+             "Features of theta (0: --num_features). At most 1024.");
 DEFINE_string(learn_hyperparameters, "auto",
               "Learn the prior's hyperparameters from the data: on, off or "
               "auto. RFF: lengthscales and variances of x, y and theta by the "

@@ -50,9 +50,10 @@ struct FeatureTrajectoryOptions {
 inline constexpr int kAutoCapacity = 0;
 inline constexpr int kMaxAutoFeatures = 512;
 // Bounds of a requested basis: the whitening prior of a segment's D weights
-// is a dense D x D Jacobian block (3 x 2048^2 doubles: 100 MB), and the
-// blocks of every segment are held at once.
-inline constexpr int kMaxFeatures = 2048;
+// is a dense D x D Jacobian block, the blocks of every segment are held at
+// once, and a dense system of 3 D weights costs O(D^3) per iteration (D =
+// 1000 takes about 15 s on an 11-pose run, D = 2048 more than 2 minutes).
+inline constexpr int kMaxFeatures = 1024;
 inline constexpr int kMaxSegments = 100000;
 inline constexpr double kMaxPriorNonZeros = 2e8;  // 1.6 GB of Jacobian.
 

@@ -1,5 +1,6 @@
 #include "rff_ceres/linear_system_size.h"
 
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -64,6 +65,29 @@ LinearSystemSize EstimateLinearSystemSize(SlamProblem* problem,
       size = {8.0 * entries, t, t, "reduced system"};
       break;
     }
+    case ceres::SPARSE_NORMAL_CHOLESKY: {
+      // J^T J has a dense block for every pair of parameter blocks that
+      // share a residual block; the factor about as many again.
+      std::set<std::pair<const double*, const double*>> pairs;
+      std::vector<ceres::ResidualBlockId> residuals;
+      ceres_problem->GetResidualBlocks(&residuals);
+      std::vector<double*> blocks;
+      double entries = 0.0;
+      for (const ceres::ResidualBlockId id : residuals) {
+        ceres_problem->GetParameterBlocksForResidualBlock(id, &blocks);
+        for (const double* a : blocks) {
+          for (const double* b : blocks) {
+            if (a <= b && pairs.emplace(a, b).second) {
+              entries +=
+                  static_cast<double>(ceres_problem->ParameterBlockSize(a)) *
+                  ceres_problem->ParameterBlockSize(b);
+            }
+          }
+        }
+      }
+      size = {2.0 * 8.0 * entries, n, n, "normal equations (sparse)"};
+      break;
+    }
     default:
       break;
   }
@@ -74,7 +98,16 @@ double MemoryLimitBytes(double max_memory_gb) {
   if (max_memory_gb > 0.0) return max_memory_gb * 1e9;
   const long pages = sysconf(_SC_PHYS_PAGES);
   const long page_size = sysconf(_SC_PAGE_SIZE);
-  return 0.5 * static_cast<double>(pages) * static_cast<double>(page_size);
+  double limit =
+      0.5 * static_cast<double>(pages) * static_cast<double>(page_size);
+  // Under an address-space limit (ulimit -v) allocation fails long before
+  // physical memory runs out.
+  rlimit address_space;
+  if (getrlimit(RLIMIT_AS, &address_space) == 0 &&
+      address_space.rlim_cur != RLIM_INFINITY) {
+    limit = std::min(limit, 0.5 * static_cast<double>(address_space.rlim_cur));
+  }
+  return limit;
 }
 
 bool CheckLinearSystemFits(SlamProblem* problem,
@@ -83,15 +116,20 @@ bool CheckLinearSystemFits(SlamProblem* problem,
   const LinearSystemSize size =
       EstimateLinearSystemSize(problem, options.linear_solver_type);
   if (size.bytes <= limit_bytes) return true;
+  const bool dense = options.linear_solver_type == ceres::DENSE_QR ||
+                     options.linear_solver_type == ceres::DENSE_SCHUR ||
+                     options.linear_solver_type == ceres::DENSE_NORMAL_CHOLESKY;
   char buffer[400];
   std::snprintf(
       buffer, sizeof(buffer),
       "linear solver %s needs about %.3g GB for its %lld x %lld %s, more "
-      "than the %.3g GB allowed (--max_memory_gb); --linear_solver=auto picks "
-      "a sparse factorisation where the system is banded",
+      "than the %.3g GB allowed (--max_memory_gb); %s",
       ceres::LinearSolverTypeToString(options.linear_solver_type),
       size.bytes / 1e9, size.rows, size.cols, size.what.c_str(),
-      limit_bytes / 1e9);
+      limit_bytes / 1e9,
+      dense ? "--linear_solver=auto picks a sparse factorisation where the "
+              "system is banded"
+            : "give fewer features or longer segments");
   *error = buffer;
   return false;
 }

@@ -13,7 +13,7 @@
 namespace rff {
 
 struct LinearSystemSize {
-  double bytes = 0.0;  // 0 where no bound is computed (sparse, iterative).
+  double bytes = 0.0;  // 0 where no bound is computed (iterative solvers).
   long long rows = 0;  // Of the system whose size is `bytes`.
   long long cols = 0;
   std::string what;  // "reduced system", "normal equations", "Jacobian".
@@ -25,11 +25,13 @@ struct LinearSystemSize {
 // twice, matrix and factor). SPARSE_SCHUR:
 // the reduced system's blocks that the landmarks couple, at most t x t
 // (sum over landmarks of (trajectory parameters it sees)^2).
+// SPARSE_NORMAL_CHOLESKY: the blocks of J^T J (every pair of parameter
+// blocks sharing a residual block), twice, matrix and factor.
 LinearSystemSize EstimateLinearSystemSize(SlamProblem* problem,
                                           ceres::LinearSolverType type);
 
 // The memory limit of --max_memory_gb: `max_memory_gb` GB, or with 0 half of
-// the machine's physical memory.
+// the machine's physical memory or of the address-space limit, the smaller.
 double MemoryLimitBytes(double max_memory_gb);
 
 // False, with the message a user needs (solver, size, limit and the way

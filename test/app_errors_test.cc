@@ -89,7 +89,7 @@ const AppCase kAppCases[] = {
      "illegal value 'abc' specified for int32 flag 'num_features'",
      "{dir}/out.tum"},
     {"SlamNegativeD", SLAM "--num_features=-5" SLAM_OUT,
-     "num_features must be in [0, 2048] (0: from the capacity rule), got -5",
+     "num_features must be in [0, 1024] (0: from the capacity rule), got -5",
      "{dir}/out.tum"},
     {"SlamBadLearning", SLAM "--learn_hyperparameters=maybe" SLAM_OUT,
      "learn_hyperparameters must be auto, on or off, got 'maybe'",

@@ -133,14 +133,14 @@ const HostileCase kHostileCases[] = {
      ""},
     // Sizes no machine can solve.
     {"Features30000", SLAM "--num_features=30000" OUT,
-     "num_features must be in [0, 2048] (0: from the capacity rule), got "
+     "num_features must be in [0, 1024] (0: from the capacity rule), got "
      "30000",
      "{dir}/out.tum"},
     {"Features65535", SLAM "--num_features=65535" OUT,
-     "num_features must be in [0, 2048]", "{dir}/out.tum"},
+     "num_features must be in [0, 1024]", "{dir}/out.tum"},
     {"HeadingFeatures65536",
      SLAM "--num_features=10 --num_heading_features=65536" OUT,
-     "num_heading_features must be in [0, 2048] (0: from the capacity rule), "
+     "num_heading_features must be in [0, 1024] (0: from the capacity rule), "
      "got 65536",
      "{dir}/out.tum"},
     {"HeadingFeaturesWithAutoCapacity", SLAM "--num_heading_features=50" OUT,

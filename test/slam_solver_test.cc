@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <map>
+#include <set>
 
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
@@ -516,9 +517,19 @@ TEST(LinearSystemSizeTest, DenseSchurIsTwoCopiesOfTheReducedSystem) {
       EstimateLinearSystemSize(&problem, ceres::DENSE_SCHUR);
   EXPECT_EQ(size.rows, t);
   EXPECT_DOUBLE_EQ(size.bytes, 16.0 * t * t);
-  EXPECT_EQ(
+  // The normal equations: every pair of the trajectory's blocks (x, y,
+  // theta: 10 weights each, and the mean's rotation: 1) shares a residual,
+  // an observed landmark pairs with all of them and itself, one seen by
+  // nobody only with itself; twice, matrix and factor.
+  std::set<LandmarkId> observed;
+  for (const Observation& o : dataset.observations) observed.insert(o.id);
+  const double trajectory = 6 * 10 * 10 + 3 * 10 * 1 + 1 * 1;
+  const double seen = 2 * 2 + 3 * 2 * 10 + 2 * 1;
+  const double unseen = 2 * 2;
+  EXPECT_DOUBLE_EQ(
       EstimateLinearSystemSize(&problem, ceres::SPARSE_NORMAL_CHOLESKY).bytes,
-      0.0);
+      16.0 * (trajectory + seen * observed.size() +
+              unseen * (landmarks.size() - observed.size())));
 }
 
 }  // namespace
