@@ -70,6 +70,10 @@ void PrintSlamSummary(const SlamOptions& options, const SlamResult& result,
          << " learned by variance components, " << result.learning_rounds
          << " rounds\n";
   }
+  if (!result.scales_not_learned.empty()) {
+    *out << "  warning: the prior's scales were not learned: "
+         << result.scales_not_learned << "\n";
+  }
   *out << "  problem      " << s.num_residual_blocks << " residual blocks, "
        << s.num_parameters << " parameters\n"
        << "  solver       " << options.solver.linear_solver << " -> "
@@ -142,6 +146,8 @@ void WriteSummaryJson(const SlamOptions& options, const SlamResult& result,
       << ", " << FormatNumber(result.learning.level.y()) << ", "
       << FormatNumber(result.learning.level.z()) << "],\n"
       << "  \"learning_rounds\": " << result.learning_rounds << ",\n"
+      << "  \"scales_not_learned\": " << JsonString(result.scales_not_learned)
+      << ",\n"
       << "  \"prior_scale_factors\": ["
       << FormatNumber(result.prior_scale_factors[0]) << ", "
       << FormatNumber(result.prior_scale_factors[1]) << "],\n"

@@ -609,10 +609,13 @@ bool LearnPriorScales(const Dataset& dataset,
                                : &settled->trajectory.heading_kernel.variance;
   for (int round = 0; round < kMaxScaleRounds; ++round) {
     VarianceComponents components;
+    std::string why;
     if (!EstimateVarianceComponents(problem->get(), VarianceComponentOptions(),
-                                    &components, error)) {
-      *error = "learning the prior's scales: " + *error;
-      return false;
+                                    &components, &why)) {
+      // Data that leave part of the run beyond double precision (a pose
+      // after a gap of days): the scales stay as they are, and say so.
+      result->scales_not_learned = why;
+      return true;
     }
     double largest_step = 0.0;
     auto rescale = [&](VarianceGroup group, double* scale) {

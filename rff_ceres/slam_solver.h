@@ -135,6 +135,9 @@ struct SlamResult {
   // Rounds of variance-component rescaling of the prior's scales, and the
   // last round's factors (position, heading): about 1 at the fixed point.
   int learning_rounds = 0;
+  // Why the scales kept their values although learning was on (the
+  // information matrix numerically singular); empty otherwise.
+  std::string scales_not_learned;
   Eigen::Vector2d prior_scale_factors = Eigen::Vector2d::Ones();
   // The linear solver used and why ("auto" settles on one per problem).
   std::string linear_solver;
