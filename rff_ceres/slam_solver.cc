@@ -897,20 +897,6 @@ bool RunSlamAtOrigin(const Dataset& dataset, const SlamOptions& options,
   return true;
 }
 
-// The dataset moved by `offset` in the plane (every position it holds).
-Dataset Translated(const Dataset& dataset, const Eigen::Vector2d& offset) {
-  Dataset moved = dataset;
-  auto move = [&](double* x, double* y) {
-    *x += offset.x();
-    *y += offset.y();
-  };
-  for (PosePrior& p : moved.pose_priors) move(&p.pose.x, &p.pose.y);
-  for (LandmarkPrior& p : moved.landmark_priors) move(&p.x, &p.y);
-  for (TimedPose& p : moved.ground_truth) move(&p.x, &p.y);
-  for (Landmark& l : moved.ground_truth_landmarks) move(&l.x, &l.y);
-  return moved;
-}
-
 }  // namespace
 
 // Solved about the start: Ceres's parameter tolerance is relative to the
@@ -931,7 +917,8 @@ bool RunSlam(const Dataset& dataset, const SlamOptions& options,
     p.y -= origin.y();
   }
   for (auto& [id, position] : centred.initial_landmarks) position -= origin;
-  if (!RunSlamAtOrigin(Translated(dataset, -origin), centred, result, error)) {
+  if (!RunSlamAtOrigin(Translated(dataset, -origin.x(), -origin.y()), centred,
+                       result, error)) {
     return false;
   }
   for (TimedPose& p : result->trajectory) {

@@ -105,6 +105,21 @@ inline PosePrior& EarliestPosePrior(Dataset* dataset) {
       EarliestPosePrior(static_cast<const Dataset&>(*dataset)));
 }
 
+// The dataset moved by (dx, dy) in the plane: every position it holds (the
+// priors and the ground truth; measurements are relative).
+inline Dataset Translated(const Dataset& dataset, double dx, double dy) {
+  Dataset moved = dataset;
+  auto move = [&](double* x, double* y) {
+    *x += dx;
+    *y += dy;
+  };
+  for (PosePrior& p : moved.pose_priors) move(&p.pose.x, &p.pose.y);
+  for (LandmarkPrior& p : moved.landmark_priors) move(&p.x, &p.y);
+  for (TimedPose& p : moved.ground_truth) move(&p.x, &p.y);
+  for (Landmark& l : moved.ground_truth_landmarks) move(&l.x, &l.y);
+  return moved;
+}
+
 }  // namespace rff
 
 #endif  // RFF_CERES_TYPES_H_

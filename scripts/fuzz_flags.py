@@ -32,9 +32,13 @@ and `timeout 60`, one process at a time. A trial is a FINDING when:
 
 Findings are deduplicated by (tool, class, key line), the key line being
 the first line of stderr that is not a glog INFO line (a line with one of
-the abort texts first), with numbers stripped. Each new distinct finding is
-printed at once and shrunk by dropping fuzzed flags one at a time while the
-finding still reproduces; its minimal repro is left in WORK/repro/F<n>/.
+the abort texts first), with numbers stripped. When stderr has nothing but
+INFO lines (a solve killed by the timeout), its last line says nothing about
+the cause, so the inputs and the names of the fuzzed flags join the key.
+Each new distinct finding is printed at once and shrunk by dropping fuzzed
+flags one at a time while the finding still reproduces; its minimal repro
+is left in WORK/repro/F<n>/. Distinct findings whose minimal repros are the
+same command are marked "same as".
 Every finding (repeats too) is appended to WORK/findings.jsonl with its
 full command, and every trial to WORK/trials.jsonl.
 
@@ -74,6 +78,7 @@ SLOW_SUCCESS_S = 60
 SLOW_REJECT_S = 30
 ABORT_TEXTS = ("Check failed", "terminate called", "std::bad_alloc")
 GLOG_INFO = re.compile(r"^I\d+ \d")
+INFO_ONLY = "(INFO lines only) "
 NAN_INF = re.compile(rb"(?<![\w.])[-+]?(?:nan|inf(?:inity)?)(?!\w)", re.I)
 
 # Tools and how often a trial picks them.
@@ -480,6 +485,8 @@ def key_line(stderr, work):
     marked = [l for l in lines if any(t in l for t in ABORT_TEXTS)]
     plain = [l for l in lines if not GLOG_INFO.match(l)]
     line = (marked or plain or lines[-1:] or [""])[0]
+    if GLOG_INFO.match(line):
+        line = INFO_ONLY + line
     line = line.replace(str(work), "WORK")
     return re.sub(r"\d+(\.\d+)?([eE][-+]?\d+)?", "#", line)[:240]
 
@@ -532,16 +539,23 @@ def execute(trial, tools, data_dir, tdir, work):
 
 # ------------------------------------------------------------ the fuzzer --
 
-def dedup_key(tool, outcome):
-    return (tool, outcome.classes[0], outcome.key)
+def shape(trial):
+    """The inputs and the fuzzed flags' names: what a trial is about."""
+    inputs = sorted(v[1] for _, v in trial.effective_base() if v[0] == "in")
+    return tuple(inputs + sorted(name for name, _ in trial.fuzzed))
 
 
-def reproduces(key, tool, outcome):
+def dedup_key(trial, outcome):
+    key = (trial.tool, outcome.classes[0], outcome.key)
+    return key + shape(trial) if outcome.key.startswith(INFO_ONLY) else key
+
+
+def reproduces(key, outcome):
     if not outcome.classes or outcome.classes[0] != key[1]:
         return False
     # A timeout's last words vary from run to run; its class is enough.
     return key[1] in ("timeout", "slow_success", "slow_reject") or \
-        dedup_key(tool, outcome) == key
+        outcome.key == key[2]
 
 
 class Fuzzer:
@@ -638,7 +652,7 @@ class Fuzzer:
                 "\n")
 
     def record_finding(self, trial, outcome):
-        key = dedup_key(trial.tool, outcome)
+        key = dedup_key(trial, outcome)
         for cls in outcome.classes:
             self.class_counts[cls] = self.class_counts.get(cls, 0) + 1
         new = key not in self.distinct
@@ -681,7 +695,7 @@ class Fuzzer:
             self.reruns += 1
             outcome = execute(candidate, self.tools, self.data_dir, tdir,
                               self.work)
-            return outcome if reproduces(key, trial.tool, outcome) else None
+            return outcome if reproduces(key, outcome) else None
 
         def candidates(t):
             singles = [[f] for f in t.fuzzed] if len(t.fuzzed) > 2 else []
@@ -716,6 +730,12 @@ class Fuzzer:
         entry["repro_flagfile"] = flagfile_text
         entry["reproduced"] = confirmed
         entry["fuzzed_flags"] = len(trial.fuzzed)
+        entry["minimal"] = json.dumps([trial.tool, key[1], trial.via_flagfile,
+                                       trial.effective_base(),
+                                       sorted(trial.fuzzed)])
+        entry["same_as"] = next(
+            (e["id"] for e in self.distinct.values() if e is not entry and
+             e.get("minimal") == entry["minimal"]), None)
         shown = outcome if confirmed else None
         entry["repro_rc"] = shown.rc if shown else entry["rc"]
         entry["repro_wall_s"] = round(shown.wall, 2) if shown \
@@ -729,8 +749,8 @@ class Fuzzer:
             self.maker.avoid.add((trial.tool, name, value))
         print(f"  {entry['id']} minimal: {len(trial.fuzzed)} fuzzed flag(s), "
               f"reproduced={confirmed}, rc={entry['repro_rc']}, "
-              f"{entry['repro_wall_s']}s\n  repro: {entry['repro']}",
-              flush=True)
+              f"{entry['repro_wall_s']}s, same as: {entry['same_as']}\n"
+              f"  repro: {entry['repro']}", flush=True)
         if flagfile_text:
             print("  repro flagfile:\n    " +
                   flagfile_text.strip().replace("\n", "\n    "))
@@ -755,7 +775,9 @@ class Fuzzer:
             lines += [f"{entry['id']} [{entry['class']}] {entry['tool']} "
                       f"seen {entry['count']}x; repro rc={entry['repro_rc']} "
                       f"{entry['repro_wall_s']}s "
-                      f"reproduced={entry['reproduced']}",
+                      f"reproduced={entry['reproduced']}"
+                      + (f" (same as {entry['same_as']})"
+                         if entry["same_as"] else ""),
                       f"  key: {entry['repro_key'] or entry['key']}",
                       f"  evidence: {entry['repro_evidence']}",
                       f"  repro: {entry['repro']}"]

@@ -61,15 +61,7 @@ TEST(SlamSolverTest, ShiftingTheSceneShiftsTheAnswer) {
   std::string error;
   ASSERT_TRUE(Simulate(PaperOptions(3), &dataset, &error)) << error;
   const Eigen::Vector2d shift(1e9, -1e9);
-  Dataset far = dataset;
-  auto move = [&](double* x, double* y) {
-    *x += shift.x();
-    *y += shift.y();
-  };
-  for (PosePrior& p : far.pose_priors) move(&p.pose.x, &p.pose.y);
-  for (LandmarkPrior& p : far.landmark_priors) move(&p.x, &p.y);
-  for (TimedPose& p : far.ground_truth) move(&p.x, &p.y);
-  for (Landmark& l : far.ground_truth_landmarks) move(&l.x, &l.y);
+  const Dataset far = Translated(dataset, shift.x(), shift.y());
   for (const char* prior : {"rff", "wnoa"}) {
     SlamOptions options;
     options.prior = prior;
