@@ -9,6 +9,7 @@
 
 #include "ceres/types.h"
 #include "glog/logging.h"
+#include "rff_ceres/dead_reckoning.h"
 #include "rff_ceres/initialization.h"
 #include "rff_ceres/io/text_parser.h"
 #include "rff_ceres/landmark_init.h"
@@ -710,6 +711,21 @@ bool RunSlamAtOrigin(const Dataset& dataset, const SlamOptions& options,
         "the dataset has no observations and no odometry: nothing to "
         "estimate";
     return false;
+  }
+  // The odometry is one chain whichever mean uses it: overlapping records
+  // would count the motion in between twice.
+  if (options.problem.use_odometry && !dataset.odometry.empty()) {
+    DeadReckoningOptions chain;
+    chain.hold_through_gaps = true;
+    const auto first = std::min_element(
+        dataset.odometry.begin(), dataset.odometry.end(),
+        [](const Odometry& a, const Odometry& b) { return a.t0 < b.t0; });
+    std::vector<TimedPose> nodes;
+    std::vector<OdometryGap> gaps;
+    if (!IntegrateOdometry({first->t0, 0.0, 0.0, 0.0}, dataset.odometry, chain,
+                           &nodes, &gaps, error)) {
+      return false;
+    }
   }
   if (options.compute_covariance) {
     std::set<LandmarkId> ids;

@@ -59,6 +59,11 @@ void WriteInputs(const std::string& dir) {
     many += "PRIOR_LANDMARK " + std::to_string(id) + " 0 0 1\n";
   }
   WriteFile(dir + "/many_landmarks.rffd", many);
+  WriteFile(dir + "/overlapping_odometry.rffd",
+            valid + "ODOM 2.5 3.5 1 0 0 0.05 0.05 0.01\n");
+  WriteFile(dir + "/unlocatable.rffd",
+            "RFFD 1\nPRIOR_POSE 0 0 0 0 0.1 0.01\n"
+            "ODOM 0 1 1 0 0 0.05 0.05 0.01\nRANGE 1 7 5 0.1\n");
   std::filesystem::create_directories(dir + "/raw");
   WriteFile(dir + "/raw/Plaza1_GT.txt", "raw ground truth\n");
 }
@@ -213,6 +218,18 @@ const HostileCase kHostileCases[] = {
      "rff_simulate: error: --sigma_bearing_deg must be in (0, 360], got "
      "1e+308",
      "{dir}/s.rffd"},
+    {"OverlappingOdometryWithConstantMean",
+     "{bin}/rff_slam --dataset={dir}/overlapping_odometry.rffd "
+     "--prior_mean=constant" OUT,
+     "ODOM records [2, 3] and [2.5, 3.5] overlap (the motion in between "
+     "would be counted twice)",
+     "{dir}/out.tum"},
+    {"IncrementalUnlocatableLandmark",
+     "{bin}/rff_slam --dataset={dir}/unlocatable.rffd "
+     "--incremental_every=1" OUT,
+     "landmark 7 has no PRIOR_LANDMARK and its 0 bearing(s) and 1 range(s) "
+     "do not locate it",
+     "{dir}/out.tum"},
     {"DirectoryAsDataset", "{bin}/rff_slam --dataset={dir}" OUT,
      "rff_slam: error: {dir}: cannot open for reading: is a directory, not a "
      "file",
