@@ -100,6 +100,12 @@ std::unique_ptr<FeatureTrajectory> FeatureTrajectory::Create(
     *error = "segment length and overlap must be >= 0, with overlap < length";
     return nullptr;
   }
+  if (requested.segment_length == 0.0 && requested.segment_overlap != 0.0) {
+    *error = "segment_overlap " + FormatNumber(requested.segment_overlap) +
+             " needs a segment_length (0: one global map, or the capacity "
+             "rule's segments)";
+    return nullptr;
+  }
   // A run with one time still needs a window of positive length.
   const double length = std::max(t_end - t_begin, 1e-3);
   if (requested.segment_length > 0.0 &&

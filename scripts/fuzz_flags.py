@@ -427,21 +427,32 @@ def digests(paths):
 
 
 def run_limited(argv, cwd, stdout_path, stderr_path):
-    """Runs argv under the memory, file size and time limits."""
-    wait_for_binary(argv[0])
+    """Runs argv under the memory, file size and time limits.
+
+    A binary being relinked by a concurrent build fails to start (timeout
+    exits 126 or 127, "failed to run command"): that is no finding, so the
+    run is retried once the binary is back.
+    """
     script = (f'ulimit -v {VMEM_KB} && ulimit -f {FILE_SIZE_BLOCKS} && '
               f'exec timeout -k 5 {TIMEOUT_S} "$@"')
-    start = time.monotonic()
-    with open(stdout_path, "wb") as out, open(stderr_path, "wb") as err:
-        process = subprocess.Popen(["/bin/bash", "-c", script, "fuzz"] + argv,
-                                   cwd=cwd, stdout=out, stderr=err,
-                                   start_new_session=True)
-        try:
-            rc = process.wait(timeout=TIMEOUT_S + 30)
-        except subprocess.TimeoutExpired:
-            os.killpg(process.pid, signal.SIGKILL)
-            rc = process.wait()
-    return rc, time.monotonic() - start
+    for _ in range(60):
+        wait_for_binary(argv[0])
+        start = time.monotonic()
+        with open(stdout_path, "wb") as out, open(stderr_path, "wb") as err:
+            process = subprocess.Popen(
+                ["/bin/bash", "-c", script, "fuzz"] + argv, cwd=cwd,
+                stdout=out, stderr=err, start_new_session=True)
+            try:
+                rc = process.wait(timeout=TIMEOUT_S + 30)
+            except subprocess.TimeoutExpired:
+                os.killpg(process.pid, signal.SIGKILL)
+                rc = process.wait()
+        wall = time.monotonic() - start
+        if rc not in (126, 127) or b"failed to run command" not in \
+                Path(stderr_path).read_bytes()[:4096]:
+            break
+        time.sleep(5)
+    return rc, wall
 
 
 def read_head_and_tail(path, size=2 << 20):

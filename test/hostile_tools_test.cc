@@ -160,6 +160,8 @@ const HostileCase kHostileCases[] = {
      "segment_length 1e-05 s cuts the run's 10 s into more than 100000 "
      "segments",
      "{dir}/out.tum"},
+    {"OverlapWithoutSegments", SLAM "--segment_overlap=1e308" OUT,
+     "segment_overlap 1e+308 needs a segment_length", "{dir}/out.tum"},
     {"OuterRoundsForever", SLAM "--outer_rounds=2147483647" OUT,
      "outer_rounds must be in [0, 100], got 2147483647", "{dir}/out.tum"},
     {"SubsetPreconditioner",
