@@ -33,14 +33,7 @@ using testing::WriteFile;
 // Errors: one command per case. {dir}/valid.rffd holds ValidDataset(0),
 // {dir}/bad.rffd a dataset with a bad line 3, {dir}/single.rffd a single
 // PRIOR_POSE and {dir}/gt.tum a two-pose trajectory.
-struct AppCase {
-  const char* name;
-  const char* command;
-  const char* message;  // Expected part of the output.
-  const char* output;   // The file that must not be written ("" for none).
-};
-// Test names in ctest say the case, not the bytes of the struct.
-void PrintTo(const AppCase& c, std::ostream* out) { *out << c.name; }
+using AppCase = testing::ToolCase;
 
 class AppErrorTest : public ::testing::TestWithParam<AppCase> {};
 

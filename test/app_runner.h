@@ -9,6 +9,7 @@
 #include <cctype>
 #include <cmath>
 #include <cstdio>
+#include <ostream>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -102,6 +103,17 @@ inline std::string ValidDataset(double t0) {
   }
   return out.str();
 }
+
+// One command of a table-driven tool test: the expected part of its output
+// and a file it must not write.
+struct ToolCase {
+  const char* name;
+  const char* command;
+  const char* message;  // Expected part of the output.
+  const char* output;   // The file that must not be written ("" for none).
+};
+// Test names in ctest say the case, not the bytes of the struct.
+inline void PrintTo(const ToolCase& c, std::ostream* out) { *out << c.name; }
 
 }  // namespace testing
 }  // namespace rff

@@ -25,13 +25,7 @@ using testing::RunResult;
 using testing::ValidDataset;
 using testing::WriteFile;
 
-struct HostileCase {
-  const char* name;
-  const char* command;
-  const char* message;  // Expected part of the output.
-  const char* output;   // Must not exist afterwards ("" for none).
-};
-void PrintTo(const HostileCase& c, std::ostream* out) { *out << c.name; }
+using HostileCase = testing::ToolCase;
 
 // The files every case may use, in {dir}.
 void WriteInputs(const std::string& dir) {
