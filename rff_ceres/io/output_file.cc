@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <climits>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -52,6 +53,14 @@ bool CheckDirectory(const NamedPath& output, std::string* error) {
   std::error_code ec;
   if (fs::is_directory(output.path, ec)) {
     *error = Named(output) + ": is a directory; give a file name";
+    return false;
+  }
+  // Longer names fail only when the file is opened, after the work.
+  const std::string name = fs::path(output.path).filename().string();
+  if (name.size() > NAME_MAX) {
+    *error = Named(output).substr(0, 200) + "...: the file name is " +
+             std::to_string(name.size()) + " characters long, more than the " +
+             std::to_string(NAME_MAX) + " a file system allows";
     return false;
   }
   fs::path directory = fs::path(output.path).parent_path();

@@ -148,6 +148,12 @@ TEST(CheckOutputPathsTest, ChecksTheDirectoryBeforeAnyWork) {
   EXPECT_FALSE(CheckOutputPaths({}, {{"--o", dir}}, &error));
   EXPECT_EQ(error, "--o=" + dir + ": is a directory; give a file name");
   EXPECT_TRUE(CheckOutputPaths({}, {{"--o", dir + "/o.txt"}}, &error)) << error;
+  // A name longer than the file system allows fails here, not after a solve.
+  const std::string long_name(300, 'x');
+  EXPECT_FALSE(CheckOutputPaths({}, {{"--o", long_name}}, &error));
+  EXPECT_EQ(error, "--o=" + long_name.substr(0, 196) +
+                       "...: the file name is 300 characters long, more "
+                       "than the 255 a file system allows");
 }
 
 }  // namespace
