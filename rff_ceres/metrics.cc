@@ -446,10 +446,10 @@ bool WriteEvaluationJson(
     const Evaluation& evaluation,
     const std::vector<std::pair<std::string, std::string>>& inputs,
     const std::string& path, std::string* error) {
-  OutputFile file(path);
-  if (!file.Open(error)) return false;
-  WriteEvaluationJson(evaluation, inputs, &file.stream());
-  return file.Commit(error);
+  return WriteOutputFile(
+      path,
+      [&](std::ostream* out) { WriteEvaluationJson(evaluation, inputs, out); },
+      error);
 }
 
 }  // namespace rff

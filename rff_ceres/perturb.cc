@@ -2,11 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
-#include <filesystem>
 #include <string>
-#include <system_error>
 
 #include "rff_ceres/io/dataset_io.h"
+#include "rff_ceres/io/output_file.h"
 #include "rff_ceres/io/text_parser.h"
 #include "rff_ceres/simulate.h"
 
@@ -77,11 +76,6 @@ void RotateStartHeading(const PerturbOptions& options, Dataset* dataset) {
           FormatNumber(start.pose.t) + " theta " + FormatNumber(old_theta) +
           " -> " + FormatNumber(start.pose.theta) + ", sigma_theta " +
           FormatNumber(old_sigma) + " -> " + FormatNumber(start.sigma_theta));
-}
-
-bool SameFile(const std::string& a, const std::string& b) {
-  std::error_code ignored;  // A path that does not exist is no other file.
-  return a == b || std::filesystem::equivalent(a, b, ignored);
 }
 
 }  // namespace

@@ -1,9 +1,10 @@
 #include "rff_ceres/slam_report.h"
 
 #include <algorithm>
-#include <cerrno>
-#include <cstring>
+#include <functional>
 #include <memory>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include "ceres/types.h"
@@ -219,52 +220,51 @@ void WriteSummaryJson(const SlamOptions& options, const SlamResult& result,
 
 bool WriteSummaryJson(const SlamOptions& options, const SlamResult& result,
                       const std::string& path, std::string* error) {
-  OutputFile file(path);
-  if (!file.Open(error)) return false;
-  WriteSummaryJson(options, result, &file.stream());
-  return file.Commit(error);
+  return WriteOutputFile(
+      path, [&](std::ostream* out) { WriteSummaryJson(options, result, out); },
+      error);
 }
 
 bool WriteSlamOutputs(const SlamOptions& options, const SlamResult& result,
                       const SlamOutputPaths& paths, std::string* error) {
+  // Each output's path and writer (false with `error` on bad content).
+  const std::vector<
+      std::pair<std::string, std::function<bool(std::ostream*, std::string*)>>>
+      outputs = {
+          {paths.trajectory,
+           [&](std::ostream* out, std::string*) {
+             WriteTum(result.trajectory, out);
+             return true;
+           }},
+          {paths.landmarks,
+           [&](std::ostream* out, std::string*) {
+             WriteLandmarks(result.landmarks, out);
+             return true;
+           }},
+          {paths.covariance,
+           [&](std::ostream* out, std::string* why) {
+             return WritePoseCovariances(result.trajectory,
+                                         result.pose_covariances, out, why);
+           }},
+          {paths.summary_json,
+           [&](std::ostream* out, std::string*) {
+             WriteSummaryJson(options, result, out);
+             return true;
+           }},
+      };
   std::vector<std::unique_ptr<OutputFile>> staged;
-  auto stage = [&](const std::string& path) -> std::ostream* {
-    if (path.empty()) return nullptr;
+  for (const auto& [path, write] : outputs) {
+    if (path.empty()) continue;
     staged.push_back(std::make_unique<OutputFile>(path));
-    return staged.back()->Open(error) ? &staged.back()->stream() : nullptr;
-  };
-  if (std::ostream* out = stage(paths.trajectory)) {
-    WriteTum(result.trajectory, out);
-  } else if (!paths.trajectory.empty()) {
-    return false;
-  }
-  if (std::ostream* out = stage(paths.landmarks)) {
-    WriteLandmarks(result.landmarks, out);
-  } else if (!paths.landmarks.empty()) {
-    return false;
-  }
-  if (std::ostream* out = stage(paths.covariance)) {
-    if (!WritePoseCovariances(result.trajectory, result.pose_covariances, out,
-                              error)) {
-      *error = paths.covariance + ": " + *error;
+    OutputFile& file = *staged.back();
+    if (!file.Open(error)) return false;
+    if (!write(&file.stream(), error)) {
+      *error = path + ": " + *error;
       return false;
     }
-  } else if (!paths.covariance.empty()) {
-    return false;
-  }
-  if (std::ostream* out = stage(paths.summary_json)) {
-    WriteSummaryJson(options, result, out);
-  } else if (!paths.summary_json.empty()) {
-    return false;
+    if (!file.Close(error)) return false;
   }
   // Every file is complete before any replaces its path.
-  for (const auto& file : staged) {
-    file->stream().flush();
-    if (!file->stream()) {
-      *error = file->path() + ": write failed: " + std::strerror(errno);
-      return false;
-    }
-  }
   for (const auto& file : staged) {
     if (!file->Commit(error)) return false;
   }

@@ -247,10 +247,10 @@ void SolveAndEvaluate(const Dataset& dataset, const SlamOptions& base,
 
 bool WriteText(const std::string& path, const std::string& text,
                ExperimentSummary* summary, std::string* error) {
-  OutputFile file(path);
-  if (!file.Open(error)) return false;
-  file.stream() << text;
-  if (!file.Commit(error)) return false;
+  if (!WriteOutputFile(
+          path, [&](std::ostream* out) { *out << text; }, error)) {
+    return false;
+  }
   if (std::find(summary->files.begin(), summary->files.end(), path) ==
       summary->files.end()) {
     summary->files.push_back(path);

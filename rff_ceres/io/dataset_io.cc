@@ -331,10 +331,8 @@ void WriteDataset(const Dataset& dataset, std::ostream* output) {
 
 bool WriteDataset(const Dataset& dataset, const std::string& path,
                   std::string* error) {
-  OutputFile file(path);
-  if (!file.Open(error)) return false;
-  WriteDataset(dataset, &file.stream());
-  return file.Commit(error);
+  return WriteOutputFile(
+      path, [&](std::ostream* out) { WriteDataset(dataset, out); }, error);
 }
 
 }  // namespace rff

@@ -15,9 +15,9 @@ std::string FlagName(const std::string& arg) {
   std::size_t begin = 0;
   while (begin < arg.size() && begin < 2 && arg[begin] == '-') ++begin;
   if (begin == 0) return "";
-  return arg.substr(begin, arg.find('=') == std::string::npos
-                               ? std::string::npos
-                               : arg.find('=') - begin);
+  const std::size_t equals = arg.find('=');
+  return arg.substr(begin,
+                    equals == std::string::npos ? equals : equals - begin);
 }
 
 std::string FlagValue(const std::string& arg) {

@@ -27,10 +27,8 @@ void WriteLandmarks(std::vector<Landmark> landmarks, std::ostream* output) {
 
 bool WriteLandmarks(const std::vector<Landmark>& landmarks,
                     const std::string& path, std::string* error) {
-  OutputFile file(path);
-  if (!file.Open(error)) return false;
-  WriteLandmarks(landmarks, &file.stream());
-  return file.Commit(error);
+  return WriteOutputFile(
+      path, [&](std::ostream* out) { WriteLandmarks(landmarks, out); }, error);
 }
 
 bool ParseLandmarks(std::istream* input, const std::string& source,

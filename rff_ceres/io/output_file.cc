@@ -26,15 +26,6 @@ fs::path Resolved(const std::string& path) {
   return resolved;
 }
 
-bool SameFile(const std::string& a, const std::string& b) {
-  std::error_code ec;
-  if (fs::exists(a, ec) && fs::exists(b, ec)) {
-    const bool same = fs::equivalent(a, b, ec);
-    if (!ec) return same;
-  }
-  return Resolved(a) == Resolved(b);
-}
-
 // Whether `file` lies under the directory `directory`.
 bool IsUnder(const std::string& file, const std::string& directory) {
   const fs::path dir = Resolved(directory);
@@ -80,6 +71,15 @@ bool CheckDirectory(const NamedPath& output, std::string* error) {
 }
 
 }  // namespace
+
+bool SameFile(const std::string& a, const std::string& b) {
+  std::error_code ec;
+  if (fs::exists(a, ec) && fs::exists(b, ec)) {
+    const bool same = fs::equivalent(a, b, ec);
+    if (!ec) return same;
+  }
+  return Resolved(a) == Resolved(b);
+}
 
 bool CheckOutputPaths(const std::vector<NamedPath>& inputs,
                       const std::vector<NamedPath>& outputs,
@@ -152,11 +152,12 @@ bool OutputFile::Open(std::string* error) {
   return true;
 }
 
-bool OutputFile::Commit(std::string* error) {
+bool OutputFile::Close(std::string* error) {
   if (temporary_.empty()) {
     *error = path_ + ": write failed: the file was not opened";
     return false;
   }
+  if (!stream_.is_open()) return true;
   stream_.flush();
   const bool written = static_cast<bool>(stream_);
   const int write_errno = errno;
@@ -168,6 +169,11 @@ bool OutputFile::Commit(std::string* error) {
     Discard();
     return false;
   }
+  return true;
+}
+
+bool OutputFile::Commit(std::string* error) {
+  if (!Close(error)) return false;
   if (std::rename(temporary_.c_str(), path_.c_str()) != 0) {
     *error = path_ + ": cannot replace the file: " + std::strerror(errno);
     Discard();
@@ -177,11 +183,12 @@ bool OutputFile::Commit(std::string* error) {
   return true;
 }
 
-bool WriteTextFile(const std::string& path, const std::string& text,
-                   std::string* error) {
+bool WriteOutputFile(const std::string& path,
+                     const std::function<void(std::ostream*)>& write,
+                     std::string* error) {
   OutputFile file(path);
   if (!file.Open(error)) return false;
-  file.stream() << text;
+  write(&file.stream());
   return file.Commit(error);
 }
 

@@ -6,10 +6,16 @@
 #define RFF_CERES_IO_OUTPUT_FILE_H_
 
 #include <fstream>
+#include <functional>
+#include <ostream>
 #include <string>
 #include <vector>
 
 namespace rff {
+
+// Whether `a` and `b` name one file: the same device and inode when both
+// exist, else the same resolved path.
+bool SameFile(const std::string& a, const std::string& b);
 
 // One path given to a tool, with the flag that named it (for messages).
 struct NamedPath {
@@ -38,11 +44,11 @@ class OutputFile {
 
   bool Open(std::string* error);
   std::ostream& stream() { return stream_; }
-  // Flushes and closes the temporary file and renames it over the path;
-  // on a write error removes it and leaves any old file as it was.
+  // Flushes and closes the temporary file; on a write error removes it
+  // (any old file at the path stays as it was).
+  bool Close(std::string* error);
+  // Closes the temporary file if still open and renames it over the path.
   bool Commit(std::string* error);
-
-  const std::string& path() const { return path_; }
 
  private:
   void Discard();
@@ -52,9 +58,11 @@ class OutputFile {
   std::ofstream stream_;
 };
 
-// Writes `text` to `path` atomically.
-bool WriteTextFile(const std::string& path, const std::string& text,
-                   std::string* error);
+// Writes `path` atomically with `write` (an OutputFile opened, written and
+// committed).
+bool WriteOutputFile(const std::string& path,
+                     const std::function<void(std::ostream*)>& write,
+                     std::string* error);
 
 }  // namespace rff
 

@@ -64,10 +64,9 @@ void WritePoseCovariances(const std::vector<PoseCovariance>& covariances,
 
 bool WritePoseCovariances(const std::vector<PoseCovariance>& covariances,
                           const std::string& path, std::string* error) {
-  OutputFile file(path);
-  if (!file.Open(error)) return false;
-  WritePoseCovariances(covariances, &file.stream());
-  return file.Commit(error);
+  return WriteOutputFile(
+      path, [&](std::ostream* out) { WritePoseCovariances(covariances, out); },
+      error);
 }
 
 bool WritePoseCovariances(const std::vector<TimedPose>& trajectory,

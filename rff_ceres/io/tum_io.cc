@@ -20,10 +20,8 @@ void WriteTum(const std::vector<TimedPose>& poses, std::ostream* output) {
 
 bool WriteTum(const std::vector<TimedPose>& poses, const std::string& path,
               std::string* error) {
-  OutputFile file(path);
-  if (!file.Open(error)) return false;
-  WriteTum(poses, &file.stream());
-  return file.Commit(error);
+  return WriteOutputFile(
+      path, [&](std::ostream* out) { WriteTum(poses, out); }, error);
 }
 
 bool ParseTum(std::istream* input, const std::string& source,

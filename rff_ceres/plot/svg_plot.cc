@@ -385,10 +385,8 @@ bool WriteSvg(const Plot& plot, const std::string& path, std::string* error) {
     *error = path + ": " + *error;
     return false;
   }
-  OutputFile file(path);
-  if (!file.Open(error)) return false;
-  file.stream() << svg;
-  return file.Commit(error);
+  return WriteOutputFile(
+      path, [&](std::ostream* out) { *out << svg; }, error);
 }
 
 }  // namespace rff
