@@ -42,6 +42,13 @@ int AutoNumFeatures(const KernelOptions& kernel_options, double missed_sigma,
   return d;
 }
 
+// Segments of (at most) `segment_length` over `duration`, all of one length;
+// 1 without segments. A double: a tiny length must not overflow an int.
+double SegmentCount(double segment_length, double duration) {
+  if (!(segment_length > 0.0)) return 1.0;
+  return std::max(1.0, std::ceil(duration / segment_length - 1e-9));
+}
+
 }  // namespace
 
 FeatureTrajectoryOptions AutoCapacity(const FeatureTrajectoryOptions& options,
@@ -55,12 +62,9 @@ FeatureTrajectoryOptions AutoCapacity(const FeatureTrajectoryOptions& options,
     filled.segment_overlap = kOverlapLengthscales * lengthscale;
   }
   // Every segment has the length of the first (Create splits evenly).
-  const int segments =
-      filled.segment_length > 0.0
-          ? std::max(1, static_cast<int>(
-                            std::ceil(duration / filled.segment_length - 1e-9)))
-          : 1;
-  const double window = duration / segments + filled.segment_overlap;
+  const double window =
+      duration / SegmentCount(filled.segment_length, duration) +
+      filled.segment_overlap;
   filled.num_position_features =
       AutoNumFeatures(options.position_kernel, options.capacity_position_sigma,
                       options, 0.0, window);
@@ -118,9 +122,7 @@ std::unique_ptr<FeatureTrajectory> FeatureTrajectory::Create(
   }
   const FeatureTrajectoryOptions options = AutoCapacity(requested, length);
   const double num_segments_needed =
-      options.segment_length > 0.0
-          ? std::ceil(length / options.segment_length - 1e-9)
-          : 1.0;
+      SegmentCount(options.segment_length, length);
   const double dp = options.num_position_features;
   const double dh = options.num_heading_features;
   if (num_segments_needed * (2.0 * dp * dp + dh * dh) > kMaxPriorNonZeros) {
@@ -140,11 +142,8 @@ std::unique_ptr<FeatureTrajectory> FeatureTrajectory::Create(
   model->heading_kernel_ = CreateKernel(options.heading_kernel, error);
   if (!model->heading_kernel_) return nullptr;
 
-  const int num_segments =
-      options.segment_length > 0.0
-          ? std::max(1, static_cast<int>(
-                            std::ceil(length / options.segment_length - 1e-9)))
-          : 1;
+  // Bounded above by the prior's size check.
+  const int num_segments = static_cast<int>(num_segments_needed);
   const double segment = length / num_segments;
   model->overlap_ = num_segments > 1 ? options.segment_overlap : 0.0;
   for (int k = 0; k < num_segments; ++k) {
