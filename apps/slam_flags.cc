@@ -117,6 +117,12 @@ DEFINE_double(range_scale_sigma, 0.1,
               "Prior sigma of the range scale around 1.");
 DEFINE_double(range_offset_sigma, 1.0,
               "Prior sigma of the range offset around 0 (m).");
+DEFINE_bool(estimate_odometry_calibration, false,
+            "Estimate the odometry's translation scale and turn scale jointly "
+            "(one each per run): the ODOM motion is modelled as the true one "
+            "scaled, as commanded velocities and wheel radii have it.");
+DEFINE_double(odometry_scale_sigma, 0.1,
+              "Prior sigma of both odometry scales around 1.");
 DEFINE_bool(use_odometry, true, "Add the ODOM records as residuals.");
 DEFINE_bool(preintegrate_odometry, true,
             "Compose ODOM chains between observation times into one residual "
@@ -220,6 +226,9 @@ SlamOptions SlamOptionsFromFlags() {
   calibration.estimate = FLAGS_estimate_range_calibration;
   calibration.scale_sigma = FLAGS_range_scale_sigma;
   calibration.offset_sigma = FLAGS_range_offset_sigma;
+  options.problem.odometry_calibration.estimate =
+      FLAGS_estimate_odometry_calibration;
+  options.problem.odometry_calibration.scale_sigma = FLAGS_odometry_scale_sigma;
   options.problem.preintegrate_odometry = FLAGS_preintegrate_odometry;
   options.problem.max_preintegration_seconds = FLAGS_max_preintegration_seconds;
   SolverOptions& s = options.solver;

@@ -73,6 +73,12 @@ QualityReport AssessQuality(
         ", offset " + Short(facts.range_calibration[1]) +
         " m) is held by its bound");
   }
+  if (facts.odometry_calibration_at_bound) {
+    report.reasons.push_back(
+        "the odometry calibration (scale " +
+        Short(facts.odometry_calibration[0]) + ", turn scale " +
+        Short(facts.odometry_calibration[1]) + ") is held by its bound");
+  }
   if (!report.reasons.empty()) report.verdict = "suspect";
   return report;
 }

@@ -46,6 +46,10 @@ struct SolveFacts {
   bool range_calibrated = false;
   Eigen::Vector2d range_calibration = Eigen::Vector2d(1.0, 0.0);
   bool range_calibration_at_bound = false;
+  // Odometry self-calibration: (translation scale, turn scale), (1, 1) when
+  // not estimated, and whether a bound holds it.
+  Eigen::Vector2d odometry_calibration = Eigen::Vector2d(1.0, 1.0);
+  bool odometry_calibration_at_bound = false;
 };
 
 // `residuals`: whitened residuals by kind (SlamProblem::

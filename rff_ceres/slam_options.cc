@@ -97,6 +97,7 @@ bool ValidateSlamOptions(const SlamOptions& options, std::string* error) {
       !WnoaTrajectory::Create(options.wnoa, mean, {0.0}, error)) {
     return false;
   }
+  if (!CheckCalibrationOptions(options.problem, error)) return false;
   std::unique_ptr<ceres::LossFunction> loss;
   if (!CreateLoss(options.problem.loss, &loss, error)) return false;
   if (!CreateLoss(options.problem.odometry_loss, &loss, error)) {

@@ -5,6 +5,7 @@
 
 #include "Eigen/Eigenvalues"
 #include "costs/bearing_cost.h"
+#include "costs/calibrated_odometry_cost.h"
 #include "costs/calibrated_range_cost.h"
 #include "costs/diagonal_prior_cost.h"
 #include "costs/landmark_prior_cost.h"
@@ -99,6 +100,22 @@ void SlamProblem::AddObservation(const Observation& o) {
            {kinds[static_cast<int>(o.type)], o.t, o.t, o.id, true});
 }
 
+bool CheckCalibrationOptions(const ProblemOptions& options,
+                             std::string* error) {
+  const std::pair<const char*, double> sigmas[] = {
+      {"range_scale_sigma", options.range_calibration.scale_sigma},
+      {"range_offset_sigma", options.range_calibration.offset_sigma},
+      {"odometry_scale_sigma", options.odometry_calibration.scale_sigma}};
+  for (const auto& [name, sigma] : sigmas) {
+    if (!(sigma > 0.0) || !std::isfinite(sigma)) {
+      *error = std::string(name) + " must be finite and > 0, got " +
+               FormatNumber(sigma);
+      return false;
+    }
+  }
+  return true;
+}
+
 bool SlamProblem::Begin(const std::vector<LandmarkId>& landmark_ids,
                         std::string* error) {
   if (!CreateLoss(options_.loss, &loss_, error)) return false;
@@ -114,37 +131,34 @@ bool SlamProblem::Begin(const std::vector<LandmarkId>& landmark_ids,
     problem_->AddParameterBlock(model_->mutable_block(b),
                                 model_->block_size(b));
   }
-  const RangeCalibrationOptions& calibration = options_.range_calibration;
-  if (calibration.estimate) {
-    for (const double sigma :
-         {calibration.scale_sigma, calibration.offset_sigma}) {
-      if (!(sigma > 0.0) || !std::isfinite(sigma)) {
-        *error =
-            "range calibration prior sigmas must be finite and > 0, "
-            "got " +
-            FormatNumber(sigma);
-        return false;
-      }
-    }
-    Remember(
-        problem_->AddResidualBlock(
-            new DiagonalPriorCost(Eigen::Vector2d(1.0, 0.0),
-                                  Eigen::Vector2d(calibration.scale_sigma,
-                                                  calibration.offset_sigma)),
-            nullptr, range_calibration_.data()),
-        {"range calibration prior"});
-    // A physical sensor: the scale stays within a factor 2 of one and the
-    // offset within kMaxOffsetSigmas of its prior; a bound that holds the
-    // solution is reported as suspect (quality_report.h).
-    double* c = range_calibration_.data();
-    problem_->SetParameterLowerBound(c, 0, kMinRangeScale);
-    problem_->SetParameterUpperBound(c, 0, kMaxRangeScale);
-    problem_->SetParameterLowerBound(
-        c, 1, -kMaxOffsetSigmas * calibration.offset_sigma);
-    problem_->SetParameterUpperBound(
-        c, 1, kMaxOffsetSigmas * calibration.offset_sigma);
+  // Physical sensors: scales within a factor 2 of one, the range offset
+  // within kMaxOffsetSigmas of its prior; a bound that holds the solution is
+  // reported as suspect (quality_report.h). The odometry's block joins with
+  // the first odometry residual.
+  if (!CheckCalibrationOptions(options_, error)) return false;
+  const RangeCalibrationOptions& range = options_.range_calibration;
+  if (range.estimate) {
+    const double max_offset = kMaxOffsetSigmas * range.offset_sigma;
+    AddCalibration("range calibration prior", Eigen::Vector2d(1.0, 0.0),
+                   Eigen::Vector2d(range.scale_sigma, range.offset_sigma),
+                   Eigen::Vector2d(kMinRangeScale, -max_offset),
+                   Eigen::Vector2d(kMaxRangeScale, max_offset),
+                   range_calibration_.data());
   }
   return true;
+}
+
+void SlamProblem::AddCalibration(const char* kind, const Eigen::Vector2d& mean,
+                                 const Eigen::Vector2d& sigma,
+                                 const Eigen::Vector2d& lower,
+                                 const Eigen::Vector2d& upper, double* values) {
+  Remember(problem_->AddResidualBlock(new DiagonalPriorCost(mean, sigma),
+                                      nullptr, values),
+           {kind});
+  for (int i = 0; i < 2; ++i) {
+    problem_->SetParameterLowerBound(values, i, lower[i]);
+    problem_->SetParameterUpperBound(values, i, upper[i]);
+  }
 }
 
 void SlamProblem::AddLandmark(LandmarkId id, const Eigen::Vector2d& initial) {
@@ -183,12 +197,27 @@ void SlamProblem::AddPosePrior(const PosePrior& p) {
 void SlamProblem::AddOdometry(const PreintegratedOdometry& o) {
   PoseMap map0 = model_->PoseAt(o.t0);
   PoseMap map1 = model_->PoseAt(o.t1);
-  const std::vector<double*> blocks = LocalBlocks({&map0, &map1}, nullptr);
-  Remember(problem_->AddResidualBlock(
-               new OdometryCost(std::move(map0), std::move(map1), o.motion,
-                                Eigen::Matrix3d(SqrtInformation(o.covariance) /
-                                                options_.noise.odometry)),
-               odometry_loss_.get(), blocks),
+  std::vector<double*> blocks = LocalBlocks({&map0, &map1}, nullptr);
+  const Eigen::Matrix3d sqrt_information =
+      SqrtInformation(o.covariance) / options_.noise.odometry;
+  ceres::CostFunction* cost = nullptr;
+  if (options_.odometry_calibration.estimate) {
+    double* calibration = odometry_calibration_.data();
+    if (!problem_->HasParameterBlock(calibration)) {
+      AddCalibration(
+          "odometry calibration prior", Eigen::Vector2d(1.0, 1.0),
+          Eigen::Vector2d::Constant(options_.odometry_calibration.scale_sigma),
+          Eigen::Vector2d::Constant(kMinOdometryScale),
+          Eigen::Vector2d::Constant(kMaxOdometryScale), calibration);
+    }
+    blocks.push_back(calibration);
+    cost = new CalibratedOdometryCost(std::move(map0), std::move(map1),
+                                      o.motion, sqrt_information);
+  } else {
+    cost = new OdometryCost(std::move(map0), std::move(map1), o.motion,
+                            sqrt_information);
+  }
+  Remember(problem_->AddResidualBlock(cost, odometry_loss_.get(), blocks),
            {"odometry", o.t0, o.t1});
 }
 
@@ -252,7 +281,8 @@ std::string SlamProblem::Describe(ceres::ResidualBlockId id) const {
   if (s.t1 != s.t0) {
     text += " from t = " + FormatNumber(s.t0) + " to " + FormatNumber(s.t1);
   } else if (std::string(s.kind) != "landmark prior" &&
-             std::string(s.kind) != "range calibration prior") {
+             std::string(s.kind).find("calibration prior") ==
+                 std::string::npos) {
     text += " at t = " + FormatNumber(s.t0);
   }
   if (s.has_landmark) text += " of landmark " + std::to_string(s.landmark);
@@ -423,6 +453,9 @@ std::shared_ptr<ceres::ParameterBlockOrdering> SlamProblem::Ordering() {
   // A group of its own, so its place does not depend on its address.
   if (options_.range_calibration.estimate) {
     ordering->AddElementToGroup(range_calibration_.data(), 3);
+  }
+  if (problem_->HasParameterBlock(odometry_calibration_.data())) {
+    ordering->AddElementToGroup(odometry_calibration_.data(), 3);
   }
   return ordering;
 }

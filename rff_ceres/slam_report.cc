@@ -96,6 +96,11 @@ void PrintSlamSummary(const SlamOptions& options, const SlamResult& result,
     *out << "  range model  " << result.range_calibration[0] << " * distance + "
          << result.range_calibration[1] << " m\n";
   }
+  if (options.problem.odometry_calibration.estimate &&
+      options.problem.use_odometry) {
+    *out << "  odometry     scale " << result.odometry_calibration[0]
+         << ", turn scale " << result.odometry_calibration[1] << "\n";
+  }
   if (!result.updates.empty()) {
     double mean, max;
     UpdateTimes(result, &mean, &max);
@@ -196,6 +201,10 @@ void WriteSummaryJson(const SlamOptions& options, const SlamResult& result,
       << ",\n"
       << "  \"range_offset\": " << FormatNumber(result.range_calibration[1])
       << ",\n"
+      << "  \"odometry_scale\": "
+      << FormatNumber(result.odometry_calibration[0]) << ",\n"
+      << "  \"odometry_turn_scale\": "
+      << FormatNumber(result.odometry_calibration[1]) << ",\n"
       << "  \"quality\": " << JsonString(result.quality.verdict) << ",\n"
       << "  \"quality_reasons\": [";
   for (std::size_t i = 0; i < result.quality.reasons.size(); ++i) {

@@ -309,6 +309,7 @@ bool SolveBatch(const Dataset& dataset, const SlamOptions& options,
   for (int round = 0;; ++round) {
     *problem = std::make_unique<SlamProblem>(model, options.problem);
     (*problem)->set_range_calibration(result->range_calibration);
+    (*problem)->set_odometry_calibration(result->odometry_calibration);
     if (!(*problem)->Build(dataset, *landmarks, error)) return false;
     ChooseLinearSolver(options.solver, *model, &ceres_options, result);
     SetOrdering(problem->get(), &ceres_options);
@@ -325,6 +326,7 @@ bool SolveBatch(const Dataset& dataset, const SlamOptions& options,
         static_cast<int>(result->summary.iterations.size());
     *landmarks = (*problem)->landmarks();
     result->range_calibration = (*problem)->range_calibration();
+    result->odometry_calibration = (*problem)->odometry_calibration();
     if (!CollectTrajectory(dataset, *model, *landmarks, initial_extent, result,
                            error)) {
       return false;
@@ -524,6 +526,7 @@ bool SolveIncremental(const Dataset& dataset, const SlamOptions& options,
   result->converged = result->summary.termination_type == ceres::CONVERGENCE;
   *landmarks = slam.landmarks();
   result->range_calibration = slam.range_calibration();
+  result->odometry_calibration = slam.odometry_calibration();
   return true;
 }
 
@@ -558,6 +561,10 @@ SolveFacts SolveFactsOf(const SlamOptions& options, const SlamResult& result) {
   facts.range_calibration_at_bound =
       scale < kMinRangeScale + kAtBound || scale > kMaxRangeScale - kAtBound ||
       std::abs(result.range_calibration[1]) > offset_bound * (1.0 - kAtBound);
+  facts.odometry_calibration = result.odometry_calibration;
+  facts.odometry_calibration_at_bound =
+      result.odometry_calibration.minCoeff() < kMinOdometryScale + kAtBound ||
+      result.odometry_calibration.maxCoeff() > kMaxOdometryScale - kAtBound;
   return facts;
 }
 

@@ -147,6 +147,8 @@ struct SlamResult {
   double mean_seconds = 0.0;       // Time to build the mean (a "wnoa" solve).
   // (scale, offset) of the range sensor; (1, 0) unless estimated.
   Eigen::Vector2d range_calibration = Eigen::Vector2d(1.0, 0.0);
+  // (translation scale, turn scale) of the odometry; (1, 1) unless estimated.
+  Eigen::Vector2d odometry_calibration = Eigen::Vector2d(1.0, 1.0);
   // The whitened residuals at the solution and the verdict on them.
   QualityReport quality;
 };

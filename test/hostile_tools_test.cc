@@ -172,6 +172,11 @@ const HostileCase kHostileCases[] = {
     {"PreintegrationNegative", SLAM "--max_preintegration_seconds=-1" OUT,
      "max_preintegration_seconds must be finite and >= 0, got -1",
      "{dir}/out.tum"},
+    {"OdometryScaleSigmaZero", SLAM "--odometry_scale_sigma=0" OUT,
+     "odometry_scale_sigma must be finite and > 0, got 0", "{dir}/out.tum"},
+    {"RangeOffsetSigmaNaN",
+     SLAM "--estimate_range_calibration --range_offset_sigma=nan" OUT,
+     "range_offset_sigma must be finite and > 0, got nan", "{dir}/out.tum"},
     {"ConvertPriorSigmaNaN",
      "{bin}/rff_convert --format=plaza --input={dir}/raw --output={dir}/o.rffd "
      "--prior_sigma_xy=nan",
