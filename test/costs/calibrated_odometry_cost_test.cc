@@ -27,10 +27,7 @@ struct CalibratedOdometryAutoDiff {
     const T e[3] = {s * (c * dx + sn * dy) - motion.x(),
                     s * (-sn * dx + c * dy) - motion.y(),
                     Wrap(T(w * turn - motion.z()))};
-    for (int i = 0; i < 3; ++i) {
-      r[i] = T(0.0);
-      for (int k = 0; k < 3; ++k) r[i] += sqrt_information(i, k) * e[k];
-    }
+    testing::Whiten3(sqrt_information, e, r);
     return true;
   }
 };

@@ -59,6 +59,15 @@ T Wrap(const T& angle) {
   return atan2(sin(angle), cos(angle));
 }
 
+// r = L e for a 3-vector e (the whitening of the odometry twins).
+template <typename T>
+void Whiten3(const Eigen::Matrix3d& sqrt_information, const T* e, T* r) {
+  for (int i = 0; i < 3; ++i) {
+    r[i] = T(0.0);
+    for (int k = 0; k < 3; ++k) r[i] += sqrt_information(i, k) * e[k];
+  }
+}
+
 // Evaluates both costs at `parameters` and compares residuals and every
 // Jacobian (relative tolerance on the larger magnitude).
 inline void ExpectSameCost(const ceres::CostFunction& analytic,

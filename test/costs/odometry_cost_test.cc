@@ -20,10 +20,7 @@ struct OdometryAutoDiff {
     const T dx = p1[0] - p0[0], dy = p1[1] - p0[1];
     const T e[3] = {c * dx + s * dy - motion.x(), -s * dx + c * dy - motion.y(),
                     Wrap(T(p1[2] - p0[2] - motion.z()))};
-    for (int i = 0; i < 3; ++i) {
-      r[i] = T(0.0);
-      for (int k = 0; k < 3; ++k) r[i] += sqrt_information(i, k) * e[k];
-    }
+    testing::Whiten3(sqrt_information, e, r);
     return true;
   }
 };
