@@ -2,10 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
-
 #include <iomanip>
 #include <sstream>
-
 
 namespace rff {
 namespace {
@@ -54,9 +52,8 @@ QualityReport AssessQuality(
     q.chi2_per_residual /= q.residuals;
     q.share_beyond_3_sigma = static_cast<double>(beyond) / q.residuals;
     if (q.chi2_per_residual > kMaxChi2PerResidual) {
-      report.reasons.push_back(kind + " chi2/n " +
-                               Short(q.chi2_per_residual) + " > " +
-                               Short(kMaxChi2PerResidual));
+      report.reasons.push_back(kind + " chi2/n " + Short(q.chi2_per_residual) +
+                               " > " + Short(kMaxChi2PerResidual));
     }
     if (q.share_beyond_3_sigma > kMaxShareBeyond3Sigma &&
         PoissonUpperTail(kNormalBeyond3Sigma * q.residuals, beyond) <
@@ -68,10 +65,10 @@ QualityReport AssessQuality(
     report.kinds.push_back(q);
   }
   if (facts.range_calibrated && facts.range_calibration_at_bound) {
-    report.reasons.push_back(
-        "the range calibration (scale " + Short(facts.range_calibration[0]) +
-        ", offset " + Short(facts.range_calibration[1]) +
-        " m) is held by its bound");
+    report.reasons.push_back("the range calibration (scale " +
+                             Short(facts.range_calibration[0]) + ", offset " +
+                             Short(facts.range_calibration[1]) +
+                             " m) is held by its bound");
   }
   if (facts.odometry_calibration_at_bound) {
     report.reasons.push_back(

@@ -11,6 +11,7 @@
 namespace rff {
 namespace {
 
+using ::testing::Contains;
 using ::testing::ElementsAre;
 using ::testing::HasSubstr;
 
@@ -74,6 +75,29 @@ TEST(QualityReportTest, UnconvergedSolveAndCalibrationAtItsBoundAreSuspect) {
                           "(NO_CONVERGENCE)",
                           "the range calibration (scale 0.5, offset 0 m) is "
                           "held by its bound"));
+}
+
+// Odometry that reads three times the distance travelled: the calibration
+// stops at its bound of 2, and the verdict names it.
+TEST(QualityReportTest, OdometryCalibrationAtItsBoundIsSuspect) {
+  SimulationOptions sim = PaperOptions(31);
+  sim.num_landmarks = 20;
+  Dataset dataset;
+  std::string error;
+  ASSERT_TRUE(Simulate(sim, &dataset, &error)) << error;
+  for (Odometry& o : dataset.odometry) {
+    o.dx *= 3.0;
+    o.dy *= 3.0;
+  }
+  SlamOptions options = testing::SyntheticRangeBearingOptions();
+  options.problem.odometry_calibration.estimate = true;
+  SlamResult result;
+  ASSERT_TRUE(RunSlam(dataset, options, &result, &error)) << error;
+  EXPECT_NEAR(result.odometry_calibration[0], kMaxOdometryScale, 1e-6);
+  EXPECT_EQ(result.quality.verdict, "suspect");
+  EXPECT_THAT(result.quality.reasons,
+              Contains(HasSubstr("the odometry calibration (scale 2, turn "
+                                 "scale")));
 }
 
 // The paper's protocol solves to an "ok" verdict; the same data with the
