@@ -64,7 +64,7 @@ QualityReport AssessQuality(
     }
     report.kinds.push_back(q);
   }
-  if (facts.range_calibrated && facts.range_calibration_at_bound) {
+  if (facts.range_calibration_at_bound) {
     report.reasons.push_back("the range calibration (scale " +
                              Short(facts.range_calibration[0]) + ", offset " +
                              Short(facts.range_calibration[1]) +

@@ -41,9 +41,8 @@ struct QualityReport {
 struct SolveFacts {
   bool converged = true;  // Ceres reported CONVERGENCE.
   std::string termination;
-  // Range self-calibration, when estimated: (scale, offset) and whether a
-  // bound of slam_problem.h holds it.
-  bool range_calibrated = false;
+  // Range self-calibration: (scale, offset), (1, 0) when not estimated, and
+  // whether a bound of slam_problem.h holds it.
   Eigen::Vector2d range_calibration = Eigen::Vector2d(1.0, 0.0);
   bool range_calibration_at_bound = false;
   // Odometry self-calibration: (translation scale, turn scale), (1, 1) when

@@ -552,7 +552,6 @@ SolveFacts SolveFactsOf(const SlamOptions& options, const SlamResult& result) {
   facts.converged = result.converged;
   facts.termination =
       ceres::TerminationTypeToString(result.summary.termination_type);
-  facts.range_calibrated = options.problem.range_calibration.estimate;
   facts.range_calibration = result.range_calibration;
   const double scale = result.range_calibration[0];
   const double offset_bound =

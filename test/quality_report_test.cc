@@ -24,10 +24,10 @@ std::vector<double> StandardNormal(int n, double scale, unsigned seed) {
 }
 
 TEST(QualityReportTest, ResidualsAsTheSigmasPromiseAreOk) {
-  const QualityReport report = AssessQuality(
-      {{"range", StandardNormal(5000, 1.0, 1)},
-       {"odometry", StandardNormal(3000, 0.5, 2)}},
-      SolveFacts());
+  const QualityReport report =
+      AssessQuality({{"range", StandardNormal(5000, 1.0, 1)},
+                     {"odometry", StandardNormal(3000, 0.5, 2)}},
+                    SolveFacts());
   EXPECT_EQ(report.verdict, "ok");
   EXPECT_TRUE(report.reasons.empty());
   ASSERT_EQ(report.kinds.size(), 2u);
@@ -66,7 +66,6 @@ TEST(QualityReportTest, UnconvergedSolveAndCalibrationAtItsBoundAreSuspect) {
   SolveFacts facts;
   facts.converged = false;
   facts.termination = "NO_CONVERGENCE";
-  facts.range_calibrated = true;
   facts.range_calibration = {0.5, 0.0};
   facts.range_calibration_at_bound = true;
   const QualityReport report = AssessQuality({}, facts);
@@ -111,8 +110,8 @@ TEST(QualityReportTest, SolveOfContradictoryOdometryIsSuspect) {
   std::string error;
   ASSERT_TRUE(Simulate(sim, &dataset, &error)) << error;
   SlamResult good;
-  ASSERT_TRUE(RunSlam(dataset, testing::SyntheticRangeBearingOptions(), &good,
-                      &error))
+  ASSERT_TRUE(
+      RunSlam(dataset, testing::SyntheticRangeBearingOptions(), &good, &error))
       << error;
   EXPECT_EQ(good.quality.verdict, "ok") << QualityLine(good.quality);
   for (Odometry& o : dataset.odometry) {
@@ -120,8 +119,8 @@ TEST(QualityReportTest, SolveOfContradictoryOdometryIsSuspect) {
     o.dy = -o.dy;
   }
   SlamResult bad;
-  ASSERT_TRUE(RunSlam(dataset, testing::SyntheticRangeBearingOptions(), &bad,
-                      &error))
+  ASSERT_TRUE(
+      RunSlam(dataset, testing::SyntheticRangeBearingOptions(), &bad, &error))
       << error;
   EXPECT_EQ(bad.quality.verdict, "suspect");
   EXPECT_THAT(QualityLine(bad.quality), HasSubstr("odometry chi2/n"));
