@@ -51,12 +51,13 @@ bool EstimateVarianceComponents(SlamProblem* problem,
                                 std::string* error);
 
 // The residuals and Jacobian of `blocks` (in that order, through their
-// robust losses) at the problem's current values.
+// robust losses) at the problem's current values; the Jacobian's columns are
+// the parameter blocks `columns` in that order (empty: the problem's order).
 bool Linearize(ceres::Problem* problem,
                const std::vector<ceres::ResidualBlockId>& blocks, double* cost,
                Eigen::VectorXd* residuals,
                Eigen::SparseMatrix<double, Eigen::RowMajor>* jacobian,
-               std::string* error);
+               std::string* error, const std::vector<double*>& columns = {});
 
 // "range", "bearing", "odometry", "trajectory position", ... for reports.
 const char* VarianceGroupName(VarianceGroup group);
