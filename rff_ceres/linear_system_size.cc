@@ -116,20 +116,26 @@ bool CheckLinearSystemFits(SlamProblem* problem,
   const LinearSystemSize size =
       EstimateLinearSystemSize(problem, options.linear_solver_type);
   if (size.bytes <= limit_bytes) return true;
-  const bool dense = options.linear_solver_type == ceres::DENSE_QR ||
-                     options.linear_solver_type == ceres::DENSE_SCHUR ||
-                     options.linear_solver_type == ceres::DENSE_NORMAL_CHOLESKY;
-  char buffer[400];
-  std::snprintf(
-      buffer, sizeof(buffer),
-      "linear solver %s needs about %.3g GB for its %lld x %lld %s, more "
-      "than the %.3g GB allowed (--max_memory_gb); %s",
-      ceres::LinearSolverTypeToString(options.linear_solver_type),
-      size.bytes / 1e9, size.rows, size.cols, size.what.c_str(),
-      limit_bytes / 1e9,
-      dense ? "--linear_solver=auto picks a sparse factorisation where the "
-              "system is banded"
-            : "give fewer features or longer segments");
+  const ceres::LinearSolverType type = options.linear_solver_type;
+  const bool dense = type == ceres::DENSE_QR || type == ceres::DENSE_SCHUR ||
+                     type == ceres::DENSE_NORMAL_CHOLESKY;
+  // Eliminating a landmark couples every state that sees it: one landmark
+  // seen from the whole run fills the reduced system.
+  const char* way_out =
+      type == ceres::SPARSE_SCHUR
+          ? "eliminating the landmarks couples the states that see a common "
+            "landmark; --linear_solver=auto or SPARSE_NORMAL_CHOLESKY "
+            "factorises the sparse system as it is"
+      : dense ? "--linear_solver=auto picks a sparse factorisation where the "
+                "system is banded"
+              : "give fewer features or longer segments";
+  char buffer[512];
+  std::snprintf(buffer, sizeof(buffer),
+                "linear solver %s needs about %.3g GB for its %lld x %lld %s, "
+                "more than the %.3g GB allowed (--max_memory_gb); %s",
+                ceres::LinearSolverTypeToString(type), size.bytes / 1e9,
+                size.rows, size.cols, size.what.c_str(), limit_bytes / 1e9,
+                way_out);
   *error = buffer;
   return false;
 }

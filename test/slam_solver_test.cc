@@ -15,7 +15,9 @@
 namespace rff {
 namespace {
 
+using ::testing::EndsWith;
 using ::testing::HasSubstr;
+using ::testing::StartsWith;
 
 // Options that work on the paper's simulated protocol (300 s, 1 Hz).
 SlamOptions PaperSolverOptions() {
@@ -512,6 +514,40 @@ TEST(LinearSystemSizeTest, TooLargeDenseSystemIsRefusedAndAutoSolves) {
   options.solver.linear_solver = "auto";
   ASSERT_TRUE(RunSlam(dataset, options, &result, &error)) << error;
   EXPECT_EQ(result.linear_solver, "SPARSE_NORMAL_CHOLESKY");
+}
+
+// 20k WNOA states, one landmark seen from every state: eliminating it fills
+// the reduced system (120001 x 120001), so both Schur solvers are refused
+// under the default memory limit (half of any machine below 230 GB), before
+// anything is solved, with the way out.
+TEST(LinearSystemSizeTest, SchurSolversAreRefusedWhenOneLandmarkIsSeenAlways) {
+  SimulationOptions sim = PaperOptions(7);
+  sim.num_steps = 20000;
+  sim.num_landmarks = 1;
+  sim.observations_per_step = 1;
+  Dataset dataset;
+  std::string error;
+  ASSERT_TRUE(Simulate(sim, &dataset, &error)) << error;
+  SlamOptions options;
+  options.prior = "wnoa";
+  if (MemoryLimitBytes(options.solver.max_memory_gb) >= 115e9) {
+    GTEST_SKIP() << "a machine with more than 230 GB fits the 115 GB system";
+  }
+  SlamResult result;
+  options.solver.linear_solver = "DENSE_SCHUR";
+  EXPECT_FALSE(RunSlam(dataset, options, &result, &error));
+  EXPECT_THAT(error, StartsWith("linear solver DENSE_SCHUR needs about 230 GB "
+                                "for its 120001 x 120001 reduced system"));
+  EXPECT_THAT(error, EndsWith("--linear_solver=auto picks a sparse "
+                              "factorisation where the system is banded"));
+  EXPECT_EQ(result.total_iterations, 0);
+  options.solver.linear_solver = "SPARSE_SCHUR";
+  EXPECT_FALSE(RunSlam(dataset, options, &result, &error));
+  EXPECT_THAT(error, StartsWith("linear solver SPARSE_SCHUR needs about 115 GB "
+                                "for its 120001 x 120001 reduced system"));
+  EXPECT_THAT(error, EndsWith("--linear_solver=auto or SPARSE_NORMAL_CHOLESKY "
+                              "factorises the sparse system as it is"));
+  EXPECT_EQ(result.total_iterations, 0);
 }
 
 TEST(LinearSystemSizeTest, DenseSchurIsTwoCopiesOfTheReducedSystem) {
