@@ -29,14 +29,18 @@
 
 namespace rff {
 
+inline constexpr int kAutoCapacity = 0;
+
+// The defaults are rff_slam's (test/slam_flags_test.cc): the starting point
+// of hyperparameter learning and, without it, the prior.
 struct FeatureTrajectoryOptions {
-  KernelOptions position_kernel;  // x and y
-  KernelOptions heading_kernel;   // theta
+  KernelOptions position_kernel = {"rbf", 4.0, 10.0};  // x and y: m^2, s
+  KernelOptions heading_kernel = {"rbf", 0.1, 10.0};   // theta: rad^2, s
   std::string family = "hilbert";
   // D of x and y and of theta per segment; kAutoCapacity derives D, the
   // segment length and the overlap from the lengthscales (AutoCapacity).
-  int num_position_features = 100;
-  int num_heading_features = 100;
+  int num_position_features = kAutoCapacity;
+  int num_heading_features = kAutoCapacity;
   std::uint64_t seed = 1;
   double segment_length = 0.0;   // Seconds; 0: one global segment.
   double segment_overlap = 0.0;  // Seconds, < segment_length.
@@ -47,7 +51,6 @@ struct FeatureTrajectoryOptions {
   double capacity_heading_sigma = 0.005;
 };
 
-inline constexpr int kAutoCapacity = 0;
 inline constexpr int kMaxAutoFeatures = 512;
 // Bounds of a requested basis: the whitening prior of a segment's D weights
 // is a dense D x D Jacobian block, the blocks of every segment are held at

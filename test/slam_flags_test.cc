@@ -1,0 +1,93 @@
+// rff_slam's flags at their defaults give the library's default SlamOptions:
+// a caller of RunSlam (C++ or Python) gets the solver a user of the command
+// line gets.
+#include "apps/slam_flags.h"
+
+#include "gtest/gtest.h"
+#include "rff_ceres/slam_solver.h"
+
+namespace rff {
+namespace {
+
+void ExpectSameKernel(const KernelOptions& flags, const KernelOptions& library,
+                      const char* which) {
+  SCOPED_TRACE(which);
+  EXPECT_EQ(flags.name, library.name);
+  EXPECT_EQ(flags.variance, library.variance);
+  EXPECT_EQ(flags.lengthscale, library.lengthscale);
+  EXPECT_EQ(flags.period, library.period);
+}
+
+TEST(SlamFlagsTest, DefaultFlagsGiveTheLibraryDefaults) {
+  const SlamOptions flags = SlamOptionsFromFlags();
+  const SlamOptions library;
+  EXPECT_EQ(flags.prior, library.prior);
+  EXPECT_EQ(flags.prior_mean, library.prior_mean);
+  EXPECT_EQ(flags.initial_trajectory, library.initial_trajectory);
+  EXPECT_EQ(flags.localization.position_smoothing,
+            library.localization.position_smoothing);
+  EXPECT_EQ(flags.localization.heading_smoothing,
+            library.localization.heading_smoothing);
+  EXPECT_EQ(flags.localization.correction_smoothing,
+            library.localization.correction_smoothing);
+  EXPECT_EQ(flags.localization.use_odometry, library.localization.use_odometry);
+  EXPECT_EQ(flags.wnoa.position_qc, library.wnoa.position_qc);
+  EXPECT_EQ(flags.wnoa.heading_qc, library.wnoa.heading_qc);
+  EXPECT_EQ(flags.wnoa.initial_position_sigma,
+            library.wnoa.initial_position_sigma);
+  EXPECT_EQ(flags.wnoa.initial_heading_sigma,
+            library.wnoa.initial_heading_sigma);
+  EXPECT_EQ(flags.wnoa.initial_velocity_sigma,
+            library.wnoa.initial_velocity_sigma);
+  EXPECT_EQ(flags.wnoa.initial_angular_velocity_sigma,
+            library.wnoa.initial_angular_velocity_sigma);
+  EXPECT_EQ(flags.wnoa.min_state_spacing, library.wnoa.min_state_spacing);
+  EXPECT_EQ(flags.incremental.every, library.incremental.every);
+  EXPECT_EQ(flags.incremental.lag, library.incremental.lag);
+  EXPECT_EQ(flags.outer_rounds, library.outer_rounds);
+  EXPECT_EQ(flags.learn_hyperparameters, library.learn_hyperparameters);
+  EXPECT_EQ(flags.spline_smoothing, library.spline_smoothing);
+  const FeatureTrajectoryOptions& t = flags.trajectory;
+  ExpectSameKernel(t.position_kernel, library.trajectory.position_kernel,
+                   "position kernel");
+  ExpectSameKernel(t.heading_kernel, library.trajectory.heading_kernel,
+                   "heading kernel");
+  EXPECT_EQ(t.family, library.trajectory.family);
+  EXPECT_EQ(t.num_position_features, library.trajectory.num_position_features);
+  EXPECT_EQ(t.num_heading_features, library.trajectory.num_heading_features);
+  EXPECT_EQ(t.seed, library.trajectory.seed);
+  EXPECT_EQ(t.segment_length, library.trajectory.segment_length);
+  EXPECT_EQ(t.segment_overlap, library.trajectory.segment_overlap);
+  const ProblemOptions& p = flags.problem;
+  EXPECT_EQ(p.loss.name, library.problem.loss.name);
+  EXPECT_EQ(p.loss.scale, library.problem.loss.scale);
+  EXPECT_EQ(p.odometry_loss.name, library.problem.odometry_loss.name);
+  EXPECT_EQ(p.odometry_loss.scale, library.problem.odometry_loss.scale);
+  EXPECT_EQ(p.use_odometry, library.problem.use_odometry);
+  EXPECT_EQ(p.range_calibration.estimate,
+            library.problem.range_calibration.estimate);
+  EXPECT_EQ(p.range_calibration.scale_sigma,
+            library.problem.range_calibration.scale_sigma);
+  EXPECT_EQ(p.range_calibration.offset_sigma,
+            library.problem.range_calibration.offset_sigma);
+  EXPECT_EQ(p.odometry_calibration.estimate,
+            library.problem.odometry_calibration.estimate);
+  EXPECT_EQ(p.odometry_calibration.scale_sigma,
+            library.problem.odometry_calibration.scale_sigma);
+  EXPECT_EQ(p.preintegrate_odometry, library.problem.preintegrate_odometry);
+  EXPECT_EQ(p.max_preintegration_seconds,
+            library.problem.max_preintegration_seconds);
+  const SolverOptions& s = flags.solver;
+  EXPECT_EQ(s.linear_solver, library.solver.linear_solver);
+  EXPECT_EQ(s.preconditioner, library.solver.preconditioner);
+  EXPECT_EQ(s.trust_region_strategy, library.solver.trust_region_strategy);
+  EXPECT_EQ(s.num_threads, library.solver.num_threads);
+  EXPECT_EQ(s.max_iterations, library.solver.max_iterations);
+  EXPECT_EQ(s.function_tolerance, library.solver.function_tolerance);
+  EXPECT_EQ(s.gradient_tolerance, library.solver.gradient_tolerance);
+  EXPECT_EQ(s.parameter_tolerance, library.solver.parameter_tolerance);
+  EXPECT_EQ(s.max_memory_gb, library.solver.max_memory_gb);
+}
+
+}  // namespace
+}  // namespace rff
