@@ -8,7 +8,9 @@
 
 #include "Eigen/Eigenvalues"
 #include "ceres/covariance.h"
+#include "rff_ceres/gauss_newton_system.h"
 #include "rff_ceres/io/text_parser.h"
+#include "rff_ceres/variance_components.h"
 
 namespace rff {
 namespace {
@@ -37,17 +39,16 @@ std::vector<LandmarkId> UnconstrainedLandmarks(
   return unconstrained;
 }
 
+// `method`: what failed, e.g. "ceres::Covariance (SPARSE_QR) failed: ".
 std::string SingularMessage(SlamProblem* problem,
                             const std::vector<Landmark>& landmarks,
-                            const CovarianceOptions& options) {
+                            const std::string& method) {
   std::vector<LandmarkId> ids;
   for (const Landmark& l : landmarks) ids.push_back(l.id);
   const std::vector<LandmarkId> unconstrained =
       UnconstrainedLandmarks(problem, ids);
-  std::string message =
-      std::string("posterior covariance: ceres::Covariance (") +
-      ceres::CovarianceAlgorithmTypeToString(options.algorithm) +
-      ") failed: the information matrix J^T J is singular";
+  std::string message = "posterior covariance: " + method +
+                        "the information matrix J^T J is singular";
   if (unconstrained.empty()) return message;
   message += "; the data do not fix the position of landmark";
   if (unconstrained.size() > 1) message += "s";
@@ -63,6 +64,95 @@ std::string SingularMessage(SlamProblem* problem,
   return message;
 }
 
+// Sigma(a, b) of the trajectory block pairs (a <= b) and the landmarks'.
+struct CovarianceBlocks {
+  std::map<std::pair<int, int>, Eigen::MatrixXd> trajectory;
+  std::map<LandmarkId, Eigen::Matrix2d> landmarks;
+};
+
+// The blocks from the Schur form of J^T J (gauss_newton_system.h), linear
+// in the landmarks. Leaves `*used` false where the problem has not that
+// form (more than kMaxDenseReducedSystem trajectory parameters, a constant
+// block, a residual on two landmarks) or J^T J is not positive definite.
+bool SchurCovariance(SlamProblem* problem, const TrajectoryModel& model,
+                     const std::set<std::pair<int, int>>& block_pairs,
+                     const std::vector<Landmark>& landmarks,
+                     CovarianceBlocks* blocks, bool* used, std::string* error) {
+  *used = false;
+  ceres::Problem* ceres_problem = problem->problem();
+  int t = 0;
+  const std::vector<double*> columns = LandmarksLast(problem, &t);
+  if (t > kMaxDenseReducedSystem) return true;
+  for (double* block : columns) {
+    if (ceres_problem->IsParameterBlockConstant(block)) return true;
+  }
+  std::vector<ceres::ResidualBlockId> ids;
+  ceres_problem->GetResidualBlocks(&ids);
+  double cost = 0.0;
+  Eigen::VectorXd residuals;
+  RowMajorSparse jacobian;
+  if (!Linearize(ceres_problem, ids, &cost, &residuals, &jacobian, error,
+                 columns)) {
+    return false;
+  }
+  // Not structured or not positive definite: the QR of J (Ceres) decides,
+  // and names the landmarks the data leave free.
+  const GaussNewtonSystem system(jacobian, t);
+  if (!system.structured() || !system.positive_definite()) return true;
+  std::map<const double*, int> offset;
+  int at = 0;
+  for (double* block : columns) {
+    offset[block] = at;
+    at += ceres_problem->ParameterBlockSize(block);
+  }
+  const Eigen::MatrixXd leading = system.LeadingCovariance();
+  for (const auto& [a, b] : block_pairs) {
+    blocks->trajectory[{a, b}] =
+        leading.block(offset.at(model.block(a)), offset.at(model.block(b)),
+                      model.block_size(a), model.block_size(b));
+  }
+  const std::vector<Eigen::Matrix2d> covariances = system.LandmarkCovariances();
+  for (const Landmark& l : landmarks) {
+    blocks->landmarks[l.id] =
+        covariances[(offset.at(problem->landmark_block(l.id)) - t) / 2];
+  }
+  *used = true;
+  return true;
+}
+
+// The same blocks from ceres::Covariance with `options.algorithm`.
+bool CeresCovariance(
+    SlamProblem* problem, const TrajectoryModel& model,
+    const std::set<std::pair<int, int>>& block_pairs,
+    const std::vector<std::pair<const double*, const double*>>& requests,
+    const std::vector<Landmark>& landmarks, const CovarianceOptions& options,
+    CovarianceBlocks* blocks, std::string* error) {
+  ceres::Covariance::Options covariance_options;
+  covariance_options.algorithm_type = options.algorithm;
+  covariance_options.num_threads = options.num_threads;
+  ceres::Covariance covariance(covariance_options);
+  if (!covariance.Compute(requests, problem->problem())) {
+    *error = SingularMessage(
+        problem, landmarks,
+        std::string("ceres::Covariance (") +
+            ceres::CovarianceAlgorithmTypeToString(options.algorithm) +
+            ") failed: ");
+    return false;
+  }
+  for (const auto& [a, b] : block_pairs) {
+    RowMajorMatrix block(model.block_size(a), model.block_size(b));
+    covariance.GetCovarianceBlock(model.block(a), model.block(b), block.data());
+    blocks->trajectory.emplace(std::make_pair(a, b), block);
+  }
+  for (const Landmark& l : landmarks) {
+    Eigen::Matrix<double, 2, 2, Eigen::RowMajor> block;
+    const double* parameters = problem->landmark_block(l.id);
+    covariance.GetCovarianceBlock(parameters, parameters, block.data());
+    blocks->landmarks[l.id] = block;
+  }
+  return true;
+}
+
 }  // namespace
 
 bool ComputePosteriorCovariance(SlamProblem* problem,
@@ -71,8 +161,9 @@ bool ComputePosteriorCovariance(SlamProblem* problem,
                                 const CovarianceOptions& options,
                                 std::vector<Eigen::Matrix3d>* pose_covariances,
                                 std::vector<Landmark>* landmarks,
-                                std::string* error) {
+                                std::string* error, bool* used_schur) {
   pose_covariances->clear();
+  if (used_schur != nullptr) *used_schur = false;
   if (options.num_threads < 1) {
     *error = "posterior covariance: num_threads must be >= 1";
     return false;
@@ -115,22 +206,19 @@ bool ComputePosteriorCovariance(SlamProblem* problem,
   }
   if (requests.empty()) return true;
 
-  ceres::Covariance::Options covariance_options;
-  covariance_options.algorithm_type = options.algorithm;
-  covariance_options.num_threads = options.num_threads;
-  ceres::Covariance covariance(covariance_options);
-  if (!covariance.Compute(requests, ceres_problem)) {
-    *error = SingularMessage(problem, *landmarks, options);
+  CovarianceBlocks blocks;
+  bool schur = false;
+  if (options.use_schur &&
+      !SchurCovariance(problem, model, block_pairs, *landmarks, &blocks, &schur,
+                       error)) {
     return false;
   }
-
-  // Sigma(a, b) for a <= b, column-major.
-  std::map<std::pair<int, int>, Eigen::MatrixXd> sigma;
-  for (const auto& [a, b] : block_pairs) {
-    RowMajorMatrix block(model.block_size(a), model.block_size(b));
-    covariance.GetCovarianceBlock(model.block(a), model.block(b), block.data());
-    sigma.emplace(std::make_pair(a, b), block);
+  if (!schur && !CeresCovariance(problem, model, block_pairs, requests,
+                                 *landmarks, options, &blocks, error)) {
+    return false;
   }
+  if (used_schur != nullptr) *used_schur = schur;
+  const auto& sigma = blocks.trajectory;
   pose_covariances->reserve(times.size());
   for (std::size_t k = 0; k < times.size(); ++k) {
     const std::vector<PoseTerm>& terms = maps[k].terms;
@@ -155,9 +243,7 @@ bool ComputePosteriorCovariance(SlamProblem* problem,
     pose_covariances->push_back(pose_covariance);
   }
   for (Landmark& l : *landmarks) {
-    Eigen::Matrix<double, 2, 2, Eigen::RowMajor> block;
-    const double* parameters = problem->landmark_block(l.id);
-    covariance.GetCovarianceBlock(parameters, parameters, block.data());
+    const Eigen::Matrix2d& block = blocks.landmarks.at(l.id);
     if (!block.allFinite() || !(block(0, 0) >= 0.0) || !(block(1, 1) >= 0.0)) {
       *error = "posterior covariance: the covariance of landmark " +
                std::to_string(l.id) +

@@ -22,6 +22,10 @@
 namespace rff {
 
 struct CovarianceOptions {
+  // The Schur form of J^T J (gauss_newton_system.h: linear in the
+  // landmarks) where the trajectory has at most kMaxDenseReducedSystem
+  // parameters; ceres::Covariance with `algorithm` otherwise.
+  bool use_schur = true;
   // SPARSE_QR (SuiteSparseQR) scales to long runs but needs a full-rank
   // Jacobian; DENSE_SVD is O(n^3) in the number of parameters.
   ceres::CovarianceAlgorithmType algorithm = ceres::SPARSE_QR;
@@ -35,13 +39,14 @@ struct CovarianceOptions {
 // by id to the problem's landmark blocks; has_covariance set). Returns false
 // with a message when the information matrix is singular (naming the
 // landmarks that the data leave unconstrained) or the result is not finite.
+// `used_schur`, when given, says whether the Schur form was used.
 bool ComputePosteriorCovariance(SlamProblem* problem,
                                 const TrajectoryModel& model,
                                 const std::vector<double>& times,
                                 const CovarianceOptions& options,
                                 std::vector<Eigen::Matrix3d>* pose_covariances,
                                 std::vector<Landmark>* landmarks,
-                                std::string* error);
+                                std::string* error, bool* used_schur = nullptr);
 
 // The same with the default CovarianceOptions.
 bool ComputePosteriorCovariance(SlamProblem* problem,

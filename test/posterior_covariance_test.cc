@@ -72,8 +72,10 @@ PosePrior PriorAt(double t, double sigma_xy, double sigma_theta) {
   return p;
 }
 
+// ceres::Covariance with `algorithm`, never the Schur form.
 CovarianceOptions WithAlgorithm(ceres::CovarianceAlgorithmType algorithm) {
   CovarianceOptions options;
+  options.use_schur = false;
   options.algorithm = algorithm;
   options.num_threads = 1;
   return options;
@@ -206,64 +208,74 @@ TEST(PosteriorCovarianceTest, MatchesTheDenseInverseWithWindowedWeights) {
   ASSERT_TRUE(problem.Build(dataset, initial, &error)) << error;
   std::vector<double> times;
   for (int k = 0; k < 118; ++k) times.push_back(0.5 * k + 0.25);
-  std::vector<Eigen::Matrix3d> covariances;
-  ASSERT_TRUE(ComputePosteriorCovariance(&problem, *model, times,
-                                         WithAlgorithm(ceres::SPARSE_QR),
-                                         &covariances, &landmarks, &error))
-      << error;
+  // The Schur form (the default) and SuiteSparseQR.
+  CovarianceOptions schur = WithAlgorithm(ceres::SPARSE_QR);
+  schur.use_schur = true;
+  for (const CovarianceOptions& covariance_options :
+       {schur, WithAlgorithm(ceres::SPARSE_QR)}) {
+    SCOPED_TRACE(covariance_options.use_schur ? "schur" : "sparse QR");
+    for (Landmark& l : landmarks) l.has_covariance = false;
+    std::vector<Eigen::Matrix3d> covariances;
+    bool used_schur = false;
+    ASSERT_TRUE(ComputePosteriorCovariance(&problem, *model, times,
+                                           covariance_options, &covariances,
+                                           &landmarks, &error, &used_schur))
+        << error;
+    EXPECT_EQ(used_schur, covariance_options.use_schur);
 
-  // Dense J over [trajectory blocks..., landmark blocks...].
-  std::vector<double*> blocks;
-  std::vector<int> offsets;
-  int columns = 0;
-  for (int b = 0; b < model->num_blocks(); ++b) {
-    blocks.push_back(model->mutable_block(b));
-    offsets.push_back(columns);
-    columns += model->block_size(b);
-  }
-  const int landmark_offset = columns;
-  for (const Landmark& l : landmarks) {
-    blocks.push_back(problem.landmark_block(l.id));
-    columns += 2;
-  }
-  ceres::Problem::EvaluateOptions evaluate;
-  evaluate.parameter_blocks = blocks;
-  ceres::CRSMatrix crs;
-  ASSERT_TRUE(
-      problem.problem()->Evaluate(evaluate, nullptr, nullptr, nullptr, &crs));
-  Eigen::MatrixXd jacobian = Eigen::MatrixXd::Zero(crs.num_rows, columns);
-  for (int r = 0; r < crs.num_rows; ++r) {
-    for (int k = crs.rows[r]; k < crs.rows[r + 1]; ++k) {
-      jacobian(r, crs.cols[k]) = crs.values[k];
+    // Dense J over [trajectory blocks..., landmark blocks...].
+    std::vector<double*> blocks;
+    std::vector<int> offsets;
+    int columns = 0;
+    for (int b = 0; b < model->num_blocks(); ++b) {
+      blocks.push_back(model->mutable_block(b));
+      offsets.push_back(columns);
+      columns += model->block_size(b);
     }
-  }
-  const Eigen::MatrixXd sigma =
-      (jacobian.transpose() * jacobian)
-          .ldlt()
-          .solve(Eigen::MatrixXd::Identity(columns, columns));
-  int blended = 0;
-  for (std::size_t k = 0; k < times.size(); ++k) {
-    const PoseMap map = model->PoseAt(times[k]);
-    if (map.terms.size() == 6) ++blended;
-    Eigen::MatrixXd phi = Eigen::MatrixXd::Zero(3, columns);
-    for (const PoseTerm& term : map.terms) {
-      phi.block(term.coordinate, offsets[term.block], 1, term.phi->size()) =
-          term.phi->transpose();
+    const int landmark_offset = columns;
+    for (const Landmark& l : landmarks) {
+      blocks.push_back(problem.landmark_block(l.id));
+      columns += 2;
     }
-    const Eigen::Matrix3d expected = phi * sigma * phi.transpose();
-    EXPECT_LT((covariances[k] - expected).norm(), 1e-9 * expected.norm())
-        << "t = " << times[k] << "\n"
-        << covariances[k] << "\nvs\n"
-        << expected;
-  }
-  EXPECT_GE(blended, 10);
-  for (std::size_t k = 0; k < landmarks.size(); ++k) {
-    const Eigen::Matrix2d expected =
-        sigma.block<2, 2>(landmark_offset + 2 * k, landmark_offset + 2 * k);
-    ASSERT_TRUE(landmarks[k].has_covariance);
-    EXPECT_NEAR(landmarks[k].sxx, expected(0, 0), 1e-9 * expected.norm());
-    EXPECT_NEAR(landmarks[k].sxy, expected(0, 1), 1e-9 * expected.norm());
-    EXPECT_NEAR(landmarks[k].syy, expected(1, 1), 1e-9 * expected.norm());
+    ceres::Problem::EvaluateOptions evaluate;
+    evaluate.parameter_blocks = blocks;
+    ceres::CRSMatrix crs;
+    ASSERT_TRUE(
+        problem.problem()->Evaluate(evaluate, nullptr, nullptr, nullptr, &crs));
+    Eigen::MatrixXd jacobian = Eigen::MatrixXd::Zero(crs.num_rows, columns);
+    for (int r = 0; r < crs.num_rows; ++r) {
+      for (int k = crs.rows[r]; k < crs.rows[r + 1]; ++k) {
+        jacobian(r, crs.cols[k]) = crs.values[k];
+      }
+    }
+    const Eigen::MatrixXd sigma =
+        (jacobian.transpose() * jacobian)
+            .ldlt()
+            .solve(Eigen::MatrixXd::Identity(columns, columns));
+    int blended = 0;
+    for (std::size_t k = 0; k < times.size(); ++k) {
+      const PoseMap map = model->PoseAt(times[k]);
+      if (map.terms.size() == 6) ++blended;
+      Eigen::MatrixXd phi = Eigen::MatrixXd::Zero(3, columns);
+      for (const PoseTerm& term : map.terms) {
+        phi.block(term.coordinate, offsets[term.block], 1, term.phi->size()) =
+            term.phi->transpose();
+      }
+      const Eigen::Matrix3d expected = phi * sigma * phi.transpose();
+      EXPECT_LT((covariances[k] - expected).norm(), 1e-9 * expected.norm())
+          << "t = " << times[k] << "\n"
+          << covariances[k] << "\nvs\n"
+          << expected;
+    }
+    EXPECT_GE(blended, 10);
+    for (std::size_t k = 0; k < landmarks.size(); ++k) {
+      const Eigen::Matrix2d expected =
+          sigma.block<2, 2>(landmark_offset + 2 * k, landmark_offset + 2 * k);
+      ASSERT_TRUE(landmarks[k].has_covariance);
+      EXPECT_NEAR(landmarks[k].sxx, expected(0, 0), 1e-9 * expected.norm());
+      EXPECT_NEAR(landmarks[k].sxy, expected(0, 1), 1e-9 * expected.norm());
+      EXPECT_NEAR(landmarks[k].syy, expected(1, 1), 1e-9 * expected.norm());
+    }
   }
 }
 
@@ -395,7 +407,9 @@ TEST(PosteriorCovarianceCalibrationTest, OneSolveTwoSigmaHoldAbout95Percent) {
 
 // The RFF default with odometry is a correction around a WNOA solve: its
 // pose covariance is the WNOA solve's plus the correction's, never the
-// correction's alone (which was 300x over-confident on Plaza 1).
+// correction's alone (which was 300x over-confident on Plaza 1). The sum
+// counts the first pose's prior in both solves: at that pose (sigma 0.01 m)
+// it is up to twice the WNOA covariance, elsewhere within 1.5x.
 TEST(WnoaMeanCovarianceTest, RffCovarianceContainsTheWnoaSolves) {
   SimulationOptions simulation = PaperOptions(3);
   simulation.num_steps = 120;
@@ -414,7 +428,7 @@ TEST(WnoaMeanCovarianceTest, RffCovarianceContainsTheWnoaSolves) {
     const double ratio = rff.pose_covariances[i].topLeftCorner<2, 2>().trace() /
                          wnoa.pose_covariances[i].topLeftCorner<2, 2>().trace();
     EXPECT_GE(ratio, 1.0) << "pose " << i;
-    EXPECT_LE(ratio, 1.5) << "pose " << i;
+    EXPECT_LE(ratio, i == 0 ? 2.0 : 1.5) << "pose " << i;
   }
 }
 

@@ -1,0 +1,178 @@
+#include "rff_ceres/gauss_newton_system.h"
+
+#include <algorithm>
+
+#include "Eigen/LU"
+
+namespace rff {
+namespace {
+
+// 2^25 doubles (256 MB) for A and B together.
+constexpr double kMaxDenseEntries = 33554432.0;
+constexpr int kChunkRows = 256;
+constexpr double kMaxLandmarkCondition = 1e8;
+
+// Rows dense enough over the leading columns that dense products beat the
+// sparse J^T J: their nonzeros, squared and summed, above 1/64 of rows t^2
+// (a dense flop is ~30-60x cheaper than a scattered update).
+bool DenseRows(const RowMajorSparse& j, int t) {
+  double sparse_updates = 0.0;
+  for (Eigen::Index r = 0; r < j.rows(); ++r) {
+    const double nnz = j.outerIndexPtr()[r + 1] - j.outerIndexPtr()[r];
+    sparse_updates += nnz * nnz;
+  }
+  return 64.0 * sparse_updates > double(j.rows()) * t * t;
+}
+
+// A = J_t^T J_t (lower triangle), J_t the first t columns: dense SYRK over
+// chunks of rows, or the sparse product for sparse rows.
+Eigen::MatrixXd LeadingGram(const RowMajorSparse& j, int t) {
+  Eigen::MatrixXd a = Eigen::MatrixXd::Zero(t, t);
+  if (DenseRows(j, t)) {
+    Eigen::MatrixXd chunk(kChunkRows, t);
+    for (Eigen::Index first = 0; first < j.rows(); first += kChunkRows) {
+      const Eigen::Index rows =
+          std::min<Eigen::Index>(kChunkRows, j.rows() - first);
+      chunk.topRows(rows).setZero();
+      for (Eigen::Index i = 0; i < rows; ++i) {
+        for (RowMajorSparse::InnerIterator it(j, first + i); it; ++it) {
+          if (it.col() < t) chunk(i, it.col()) = it.value();
+        }
+      }
+      a.selfadjointView<Eigen::Lower>().rankUpdate(
+          chunk.topRows(rows).transpose());
+    }
+  } else {
+    std::vector<Eigen::Triplet<double>> entries;
+    for (Eigen::Index r = 0; r < j.rows(); ++r) {
+      for (RowMajorSparse::InnerIterator it(j, r); it; ++it) {
+        if (it.col() < t) entries.emplace_back(r, it.col(), it.value());
+      }
+    }
+    Eigen::SparseMatrix<double> leading(j.rows(), t);
+    leading.setFromTriplets(entries.begin(), entries.end());
+    a = Eigen::MatrixXd(leading.transpose() * leading);
+  }
+  a.triangularView<Eigen::StrictlyUpper>() = a.transpose();
+  return a;
+}
+
+}  // namespace
+
+std::vector<double*> LandmarksLast(SlamProblem* problem, int* num_leading) {
+  std::vector<double*> blocks, order, landmarks;
+  problem->problem()->GetParameterBlocks(&blocks);
+  const auto ordering = problem->Ordering();
+  *num_leading = 0;
+  for (double* block : blocks) {
+    if (ordering != nullptr && ordering->IsMember(block) &&
+        ordering->GroupId(block) == 0) {
+      landmarks.push_back(block);
+    } else {
+      order.push_back(block);
+      *num_leading += problem->problem()->ParameterBlockSize(block);
+    }
+  }
+  order.insert(order.end(), landmarks.begin(), landmarks.end());
+  return order;
+}
+
+GaussNewtonSystem::GaussNewtonSystem(const RowMajorSparse& jacobian, int t) {
+  const Eigen::Index m = jacobian.cols() - t;
+  if (t <= kMaxDenseReducedSystem && m % 2 == 0 &&
+      double(t) * (t + m) <= kMaxDenseEntries && FormSchur(jacobian, t)) {
+    structured_ = true;
+    return;
+  }
+  sparse_.compute(Eigen::SparseMatrix<double>(jacobian.transpose()) * jacobian);
+  positive_definite_ =
+      sparse_.info() == Eigen::Success && sparse_.vectorD().minCoeff() > 0.0;
+}
+
+// False when a row touches two landmarks (not this structure) or a
+// landmark's block is ill-conditioned.
+bool GaussNewtonSystem::FormSchur(const RowMajorSparse& j, int t) {
+  const Eigen::Index m = j.cols() - t;
+  b_ = Eigen::MatrixXd::Zero(t, m);
+  std::vector<Eigen::Matrix2d> c(m / 2, Eigen::Matrix2d::Zero());
+  for (Eigen::Index r = 0; r < j.rows(); ++r) {
+    Eigen::Index landmark = -1;
+    Eigen::Vector2d landmark_row = Eigen::Vector2d::Zero();
+    for (RowMajorSparse::InnerIterator it(j, r); it; ++it) {
+      if (it.col() < t) continue;
+      const Eigen::Index k = (it.col() - t) / 2;
+      if (landmark >= 0 && landmark != k) return false;
+      landmark = k;
+      landmark_row[(it.col() - t) % 2] = it.value();
+    }
+    if (landmark < 0) continue;
+    c[landmark].noalias() += landmark_row * landmark_row.transpose();
+    for (RowMajorSparse::InnerIterator it(j, r); it; ++it) {
+      if (it.col() >= t) continue;
+      b_.block<1, 2>(it.col(), 2 * landmark) +=
+          it.value() * landmark_row.transpose();
+    }
+  }
+  // J^T J squares the condition number of J: a landmark block left with
+  // fewer than 8 digits (a bearing taken next to its landmark), or not
+  // positive definite, goes to the sparse LDLT with its pivoting.
+  c_inverse_.resize(c.size());
+  for (std::size_t k = 0; k < c.size(); ++k) {
+    const double determinant = c[k].determinant();
+    // |C|_F^2 / det(C) ~ lambda_max / lambda_min.
+    if (!(c[k](0, 0) > 0.0 && determinant > 0.0 &&
+          c[k].squaredNorm() <= kMaxLandmarkCondition * determinant)) {
+      return false;
+    }
+    c_inverse_[k] = c[k].inverse();
+  }
+  // S = A - B C^-1 B^T, one product.
+  Eigen::MatrixXd b_c_inverse(t, m);
+  for (std::size_t k = 0; k < c_inverse_.size(); ++k) {
+    b_c_inverse.middleCols<2>(2 * k).noalias() =
+        b_.middleCols<2>(2 * k) * c_inverse_[k];
+  }
+  Eigen::MatrixXd s = LeadingGram(j, t);
+  s.noalias() -= b_c_inverse * b_.transpose();
+  schur_.compute(s);
+  positive_definite_ =
+      schur_.info() == Eigen::Success && schur_.vectorD().minCoeff() > 0.0;
+  return true;
+}
+
+Eigen::VectorXd GaussNewtonSystem::ApplyCInverse(
+    const Eigen::VectorXd& v) const {
+  Eigen::VectorXd out(v.size());
+  for (std::size_t k = 0; k < c_inverse_.size(); ++k) {
+    out.segment<2>(2 * k) = c_inverse_[k] * v.segment<2>(2 * k);
+  }
+  return out;
+}
+
+Eigen::VectorXd GaussNewtonSystem::Solve(const Eigen::VectorXd& z) const {
+  if (!structured_) return sparse_.solve(z);
+  const Eigen::Index t = b_.rows(), m = b_.cols();
+  const Eigen::VectorXd leading =
+      schur_.solve(z.head(t) - b_ * ApplyCInverse(z.tail(m)));
+  Eigen::VectorXd u(z.size());
+  u.head(t) = leading;
+  u.tail(m) = ApplyCInverse(z.tail(m) - b_.transpose() * leading);
+  return u;
+}
+
+Eigen::MatrixXd GaussNewtonSystem::LeadingCovariance() const {
+  return schur_.solve(Eigen::MatrixXd::Identity(b_.rows(), b_.rows()));
+}
+
+std::vector<Eigen::Matrix2d> GaussNewtonSystem::LandmarkCovariances() const {
+  const Eigen::MatrixXd s_inverse_b = schur_.solve(b_);
+  std::vector<Eigen::Matrix2d> covariances(c_inverse_.size());
+  for (std::size_t k = 0; k < c_inverse_.size(); ++k) {
+    const Eigen::Matrix2d coupling =
+        b_.middleCols<2>(2 * k).transpose() * s_inverse_b.middleCols<2>(2 * k);
+    covariances[k] = c_inverse_[k] + c_inverse_[k] * coupling * c_inverse_[k];
+  }
+  return covariances;
+}
+
+}  // namespace rff

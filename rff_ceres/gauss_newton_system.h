@@ -1,0 +1,66 @@
+// The Gauss-Newton information matrix H = J^T J of a SLAM problem at its
+// current values, factorised for solves and marginal covariances. With the
+// columns ordered [t columns of the trajectory and the other blocks |
+// landmarks, two each] and every row touching at most one landmark,
+//
+//   H = [A B; B^T C],  C = diag(C_1, ..., C_L),  S = A - B C^-1 B^T,
+//   H^-1 = [S^-1, -S^-1 B C^-1; ., C^-1 + C^-1 B^T S^-1 B C^-1],
+//
+// so the trajectory's covariance is S^-1 and landmark k's is
+// C_k^-1 + C_k^-1 B_k^T S^-1 B_k C_k^-1: linear in the number of landmarks
+// (the Schur complement of Ceres's own solvers, Triggs et al. 2000, 6.1).
+// This structured form is used while S (t x t) and B (t x 2L) fit in
+// memory (t <= kMaxDenseReducedSystem) and every C_k keeps 8 digits;
+// otherwise H is a sparse LDLT, for solves only.
+#ifndef RFF_CERES_GAUSS_NEWTON_SYSTEM_H_
+#define RFF_CERES_GAUSS_NEWTON_SYSTEM_H_
+
+#include <string>
+#include <vector>
+
+#include "Eigen/Cholesky"
+#include "Eigen/Core"
+#include "Eigen/SparseCholesky"
+#include "Eigen/SparseCore"
+#include "rff_ceres/slam_problem.h"
+
+namespace rff {
+
+using RowMajorSparse = Eigen::SparseMatrix<double, Eigen::RowMajor>;
+
+// The problem's parameter blocks with its landmarks (the ordering's group 0)
+// last, in the problem's order; `*num_leading` gets the parameters before
+// them. The column order GaussNewtonSystem expects.
+std::vector<double*> LandmarksLast(SlamProblem* problem, int* num_leading);
+
+class GaussNewtonSystem {
+ public:
+  // `jacobian`'s first `t` columns are the leading blocks, the rest the
+  // landmarks, two each.
+  GaussNewtonSystem(const RowMajorSparse& jacobian, int t);
+
+  // Whether the Schur form was built (covariances are available).
+  bool structured() const { return structured_; }
+  bool positive_definite() const { return positive_definite_; }
+  // H^-1 z.
+  Eigen::VectorXd Solve(const Eigen::VectorXd& z) const;
+  // Structured only: S^-1, the covariance of the leading t parameters.
+  Eigen::MatrixXd LeadingCovariance() const;
+  // Structured only: the 2x2 covariance of every landmark.
+  std::vector<Eigen::Matrix2d> LandmarkCovariances() const;
+
+ private:
+  bool FormSchur(const RowMajorSparse& jacobian, int t);
+  Eigen::VectorXd ApplyCInverse(const Eigen::VectorXd& v) const;
+
+  bool structured_ = false;
+  bool positive_definite_ = false;
+  Eigen::MatrixXd b_;
+  std::vector<Eigen::Matrix2d> c_inverse_;
+  Eigen::LDLT<Eigen::MatrixXd> schur_;
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> sparse_;
+};
+
+}  // namespace rff
+
+#endif  // RFF_CERES_GAUSS_NEWTON_SYSTEM_H_
