@@ -4,11 +4,14 @@
 //   (linearisation + Schur linear solve), with its ratio to the BLAS-3 bound.
 // - BM_GramLowerBound/rows/D: a dense BLAS-3 Gram J^T J (Eigen SYRK).
 // - BM_FullSolve/N: the whole RunSlam, windowed, fixed iterations.
+// - BM_DefaultSolver/prior/poses/solver: the whole RunSlam with default
+//   options, the "auto" linear solver against each explicit one.
 // - BM_FeatureCache/N/D/cached: building the pose maps with and without the
 //   per-time feature cache.
 //
 // Flags of our own (removed before Google Benchmark parses the rest):
 //   --large      also register the N = 1e6 BM_Iteration rows
+//   --solver_choice  register the BM_DefaultSolver rows
 //   --threads=K  Ceres threads (default 1: the BLAS-3 bound is one thread)
 //   --lm_iterations=K  LM iterations per BM_Iteration solve (default 3)
 #include <sys/resource.h>
@@ -30,9 +33,11 @@
 #include "benchmark/benchmark.h"
 #include "ceres/solver.h"
 #include "rff_ceres/feature_trajectory.h"
+#include "rff_ceres/io/dataset_io.h"
 #include "rff_ceres/io/text_parser.h"
 #include "rff_ceres/landmark_init.h"
 #include "rff_ceres/mean/prior_mean.h"
+#include "rff_ceres/metrics.h"
 #include "rff_ceres/simulate.h"
 #include "rff_ceres/slam_problem.h"
 #include "rff_ceres/slam_solver.h"
@@ -77,11 +82,15 @@ double Seconds(std::chrono::steady_clock::time_point start) {
 // landmarks are anchored along the path instead and each is observed only
 // from a local stretch, as a real sensor would, so the reduced system stays
 // banded. Every landmark gets a 5 m prior, as in the paper's protocol.
+// `per_step` observations per pose; with `landmark_seen_throughout` one more
+// landmark (id L) is also observed from every pose, the structure that
+// makes a Schur complement dense.
 bool MakeDataset(int num_observations, int num_landmarks, Dataset* dataset,
-                 std::string* error) {
-  const int steps = num_observations / kObservationsPerStep;
-  if (steps < 2 || num_landmarks < kObservationsPerStep) {
-    *error = "need N >= 20 and L >= 10";
+                 std::string* error, int per_step = kObservationsPerStep,
+                 bool landmark_seen_throughout = false) {
+  const int steps = num_observations / per_step;
+  if (steps < 2 || num_landmarks < per_step) {
+    *error = "need N >= 2 per_step and L >= per_step";
     return false;
   }
   SimulationOptions sim = PaperOptions(/*seed=*/1);
@@ -112,26 +121,40 @@ bool MakeDataset(int num_observations, int num_landmarks, Dataset* dataset,
     prior.y = landmark.y + prior.sigma * random.Normal();
     dataset->landmark_priors.push_back(prior);
   }
-  const int half_window =
-      std::max(kObservationsPerStep / 2 + 1,
-               static_cast<int>(std::ceil(kVisibilitySteps *
-                                          double(num_landmarks) / steps)));
+  if (landmark_seen_throughout) {
+    Landmark landmark;
+    landmark.id = num_landmarks;
+    landmark.x = poses[steps / 2].x + 20.0;
+    landmark.y = poses[steps / 2].y;
+    dataset->ground_truth_landmarks.push_back(landmark);
+    dataset->landmark_priors.push_back(
+        {landmark.id, landmark.x, landmark.y, sim.landmark_prior_sigma});
+  }
+  const int observed_locally =
+      landmark_seen_throughout ? per_step - 1 : per_step;
+  const int half_window = std::max(
+      per_step / 2 + 1, static_cast<int>(std::ceil(
+                            kVisibilitySteps * double(num_landmarks) / steps)));
   std::vector<int> candidates;
   for (int i = 0; i < steps; ++i) {
     const int centre =
         static_cast<int>(std::lround((i + 0.5) * num_landmarks / steps - 0.5));
     int lo = std::max(0, centre - half_window);
     int hi = std::min(num_landmarks - 1, centre + half_window);
-    while (hi - lo + 1 < kObservationsPerStep) {  // At the ends of the run.
+    while (hi - lo + 1 < per_step) {  // At the ends of the run.
       if (lo > 0) --lo;
       if (hi < num_landmarks - 1) ++hi;
     }
     candidates.resize(hi - lo + 1);
     std::iota(candidates.begin(), candidates.end(), lo);
-    for (int k = 0; k < kObservationsPerStep; ++k) {
-      std::swap(candidates[k],
-                candidates[k + random.Index(candidates.size() - k)]);
-      const Landmark& l = dataset->ground_truth_landmarks[candidates[k]];
+    for (int k = 0; k < per_step; ++k) {
+      if (k < observed_locally) {
+        std::swap(candidates[k],
+                  candidates[k + random.Index(candidates.size() - k)]);
+      }
+      const Landmark& l =
+          dataset->ground_truth_landmarks[k < observed_locally ? candidates[k]
+                                                               : num_landmarks];
       const double dx = l.x - poses[i].x, dy = l.y - poses[i].y;
       Observation o;
       o.type = ObservationType::kRangeBearing;
@@ -445,6 +468,67 @@ void BM_FullSolve(benchmark::State& state) {
   state.SetLabel("SPARSE_SCHUR D=24 windows 50s/15s L=N/50, 10 iterations");
 }
 
+// N poses at 1 Hz with three range-bearing observations each: two of local
+// landmarks (L = N / 10) and one of a landmark seen from every pose.
+const Dataset& SeenThroughoutDataset(int poses) {
+  static int key = -1;
+  static Dataset dataset;
+  if (key != poses) {
+    dataset = Dataset();
+    std::string error;
+    if (!MakeDataset(3 * poses, poses / 10, &dataset, &error, /*per_step=*/3,
+                     /*landmark_seen_throughout=*/true)) {
+      fprintf(stderr, "MakeDataset: %s\n", error.c_str());
+      std::exit(1);
+    }
+    key = poses;
+    if (const char* path = std::getenv("RFF_BENCH_DUMP")) {
+      WriteDataset(dataset, path, &error);
+    }
+  }
+  return dataset;
+}
+
+const char* const kPriorNames[] = {"rff", "wnoa"};
+// Row 0 is the default; the others are the explicit choices it must match.
+const char* const kDefaultSolverRows[] = {"auto", "SPARSE_NORMAL_CHOLESKY",
+                                          "SPARSE_SCHUR", "ITERATIVE_SCHUR",
+                                          "DENSE_SCHUR"};
+
+// The whole RunSlam with rff_slam's defaults but the prior and the linear
+// solver: auto against every explicit solver on the same problem. A solver
+// whose system would not fit is refused (the row shows the message).
+void BM_DefaultSolver(benchmark::State& state) {
+  const std::string prior = kPriorNames[state.range(0)];
+  const int poses = static_cast<int>(state.range(1));
+  const std::string solver = kDefaultSolverRows[state.range(2)];
+  const Dataset& dataset = SeenThroughoutDataset(poses);
+  SlamOptions options;
+  options.prior = prior;
+  options.solver.linear_solver = solver;
+  options.solver.num_threads = g_threads;
+  SlamResult result;
+  std::string error;
+  for (auto _ : state) {
+    if (!RunSlam(dataset, options, &result, &error)) {
+      state.SkipWithError(error.c_str());
+      return;
+    }
+  }
+  Evaluation evaluation;
+  if (!Evaluate(dataset.ground_truth, dataset.ground_truth_landmarks,
+                result.trajectory, nullptr, EvaluationOptions(), &evaluation,
+                &error)) {
+    state.SkipWithError(error.c_str());
+    return;
+  }
+  state.counters["ape_m"] = evaluation.ape_translation.rms;
+  state.counters["iterations"] = result.total_iterations;
+  state.counters["mean_ms"] = 1e3 * result.mean_seconds;
+  state.counters["peak_rss_MiB"] = PeakRssMiB();
+  state.SetLabel(result.linear_solver + ": " + result.linear_solver_reason);
+}
+
 // Pose maps of every observation, as SlamProblem::Build makes them, from a
 // fresh trajectory (empty cache). cached = 1: the real times, 10 observations
 // per time share one feature evaluation. cached = 0: every observation time
@@ -521,11 +605,13 @@ void Configure(benchmark::internal::Benchmark* b) {
 }  // namespace rff
 
 int main(int argc, char** argv) {
-  bool large = false;
+  bool large = false, solver_choice = false;
   std::vector<char*> args;
   for (int i = 0; i < argc; ++i) {
     if (std::strcmp(argv[i], "--large") == 0) {
       large = true;
+    } else if (std::strcmp(argv[i], "--solver_choice") == 0) {
+      solver_choice = true;
     } else if (std::strncmp(argv[i], "--threads=", 10) == 0) {
       rff::g_threads = std::atoi(argv[i] + 10);
     } else if (std::strncmp(argv[i], "--lm_iterations=", 16) == 0) {
@@ -556,6 +642,16 @@ int main(int argc, char** argv) {
       ->UseRealTime()
       ->Unit(benchmark::kMillisecond)
       ->Iterations(1);
+  if (solver_choice) {
+    // Default against explicit solvers at 2k, 20k and 1e5 poses, both
+    // priors; some explicit rows take hours (run them under a timeout).
+    RegisterBenchmark("BM_DefaultSolver", rff::BM_DefaultSolver)
+        ->ArgNames({"prior", "poses", "solver"})
+        ->ArgsProduct({{0, 1}, {2000, 20000, 100000}, {0, 1, 2, 3, 4}})
+        ->UseRealTime()
+        ->Unit(benchmark::kMillisecond)
+        ->Iterations(1);
+  }
   if (large) {
     rff::Configure(RegisterBenchmark("BM_Iteration", rff::BM_Iteration)
                        ->Apply(rff::LargeIterationRows));

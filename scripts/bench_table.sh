@@ -1,21 +1,28 @@
 #!/usr/bin/env bash
 # Runs the solver benchmarks (bench/solver_benchmark.cc) and prints Markdown
 # tables for the README:
-#   scripts/bench_table.sh [BUILD_DIR] [--large] [extra rff_bench flags]
+#   scripts/bench_table.sh [BUILD_DIR] [--large] [--solver_choice]
+#                          [extra rff_bench flags]
 # BUILD_DIR defaults to ./build; it is configured (Release) if it has no
 # CMakeCache.txt, and rff_bench is (re)built. The default run takes a few
 # minutes on 2 cores; --large adds the N = 1e6 BM_Iteration rows
 # (SPARSE_SCHUR, ITERATIVE_SCHUR), each in a process of its own so that its
-# peak RSS is its own (a few minutes each). Extra flags go to rff_bench, e.g. --threads=2 or
+# peak RSS is its own (a few minutes each). --solver_choice adds the
+# BM_DefaultSolver rows (default flags against each explicit linear solver,
+# 2k-1e5 poses), each in a process of its own under a 240 s timeout (about
+# 30 minutes). Extra flags go to rff_bench, e.g. --threads=2 or
 # --benchmark_repetitions=3 (the tables then use the medians).
 set -euo pipefail
 repo=$(cd "$(dirname "$0")/.." && pwd)
 build=$repo/build
 large=0
+solver_choice=0
+timeout_seconds=240
 extra=()
 for arg in "$@"; do
   case $arg in
     --large) large=1 ;;
+    --solver_choice) solver_choice=1 ;;
     --*) extra+=("$arg") ;;
     *) build=$arg ;;
   esac
@@ -40,6 +47,24 @@ if [ "$large" = 1 ]; then
   done
 fi
 
+if [ "$solver_choice" = 1 ]; then
+  for poses in 2000 20000 100000; do
+    for prior in 0 1; do
+      for solver in 0 1 2 3 4; do
+        row="BM_DefaultSolver/prior:$prior/poses:$poses/solver:$solver"
+        json="$out/choice_${prior}_${poses}_$solver.json"
+        if ! timeout "$timeout_seconds" "$bench" --solver_choice \
+            --benchmark_filter="$row/" --benchmark_out="$json" \
+            --benchmark_out_format=json ${extra[@]+"${extra[@]}"} >&2; then
+          # Killed by the timeout: a row that says so.
+          printf '{"benchmarks": [{"name": "%s", "run_name": "%s", "error_occurred": true, "error_message": "timeout %s s"}]}\n' \
+            "$row" "$row" "$timeout_seconds" > "$json"
+        fi
+      done
+    done
+  done
+fi
+
 python3 - "$out"/*.json <<'EOF'
 import json
 import sys
@@ -56,7 +81,8 @@ for path in sys.argv[1:]:
             continue
         if r.get("error_occurred"):
             print(f"<!-- {r['name']}: {r.get('error_message')} -->")
-            continue
+            if not r["name"].startswith("BM_DefaultSolver"):
+                continue
         args = {}
         parts = r["run_name"].split("/")
         for part in parts[1:]:
@@ -114,6 +140,44 @@ if full:
               f"| {fmt(r['ceres_ms'])} | {fmt(r['outside_ceres_ms'])} "
               f"| {fmt(r['ms_per_iteration'])} | {scale} | {ceres} | {cpu} "
               f"| {fmt(r['peak_rss_MiB'])} |")
+
+# Default (auto) against every explicit linear solver, whole RunSlam.
+default_solvers = ["auto", "SPARSE_NORMAL_CHOLESKY", "SPARSE_SCHUR",
+                   "ITERATIVE_SCHUR", "DENSE_SCHUR"]
+choice = {}
+for r in rows:
+    if r["bench"] == "BM_DefaultSolver":
+        a = r["args"]
+        choice.setdefault((a["prior"], int(a["poses"])), {})[
+            default_solvers[int(a["solver"])]] = r
+if choice:
+    print("\n### Default flags against each explicit linear solver "
+          "(BM_DefaultSolver)\n")
+    print("| prior | poses | " + " | ".join(default_solvers) +
+          " | auto / best explicit | APE m (auto) |")
+    print("| " + " | ".join(["---"] * (len(default_solvers) + 4)) + " |")
+    for (prior, poses), by_solver in sorted(choice.items()):
+        cells, explicit = [], []
+        for name in default_solvers:
+            r = by_solver.get(name)
+            if r is None:
+                cells.append("not run")
+            elif r.get("error_message", "").startswith("timeout"):
+                cells.append("> " + r["error_message"][8:])
+            elif r.get("error_occurred"):
+                cells.append("refused")
+            else:
+                cells.append(f"{ms(r) / 1e3:.1f} s")
+                if name != "auto":
+                    explicit.append(ms(r))
+        auto = by_solver.get("auto")
+        ratio = (fmt(ms(auto) / min(explicit))
+                 if auto and not auto.get("error_occurred") and explicit
+                 else "")
+        ape = fmt(auto["ape_m"]) if auto and "ape_m" in auto else ""
+        name = ["rff", "wnoa"][int(prior)]
+        print(f"| {name} | {poses} | " + " | ".join(cells) +
+              f" | {ratio} | {ape} |")
 
 cache = {}
 for r in rows:
