@@ -442,6 +442,20 @@ void BM_GramLowerBound(benchmark::State& state) {
   state.SetLabel("J " + std::to_string(rows) + " x " + std::to_string(cols));
 }
 
+// The timed loop of a whole-solve benchmark; false (the row marked with the
+// error) when RunSlam fails.
+bool TimeRunSlam(const Dataset& dataset, const SlamOptions& options,
+                 benchmark::State* state, SlamResult* result) {
+  std::string error;
+  for (auto _ : *state) {
+    if (!RunSlam(dataset, options, result, &error)) {
+      state->SkipWithError(error.c_str());
+      return false;
+    }
+  }
+  return true;
+}
+
 void BM_FullSolve(benchmark::State& state) {
   const int n = static_cast<int>(state.range(0));
   const int l = n / 50;
@@ -449,13 +463,7 @@ void BM_FullSolve(benchmark::State& state) {
   SlamOptions options = BenchOptions(24, 50, "SPARSE_SCHUR");
   options.solver.max_iterations = 10;
   SlamResult result;
-  std::string error;
-  for (auto _ : state) {
-    if (!RunSlam(dataset, options, &result, &error)) {
-      state.SkipWithError(error.c_str());
-      return;
-    }
-  }
+  if (!TimeRunSlam(dataset, options, &state, &result)) return;
   state.counters["iterations"] = result.total_iterations;
   state.counters["ms_per_iteration"] =
       1e3 * result.summary.minimizer_time_in_seconds / result.total_iterations;
@@ -508,14 +516,9 @@ void BM_DefaultSolver(benchmark::State& state) {
   options.solver.linear_solver = solver;
   options.solver.num_threads = g_threads;
   SlamResult result;
-  std::string error;
-  for (auto _ : state) {
-    if (!RunSlam(dataset, options, &result, &error)) {
-      state.SkipWithError(error.c_str());
-      return;
-    }
-  }
+  if (!TimeRunSlam(dataset, options, &state, &result)) return;
   Evaluation evaluation;
+  std::string error;
   if (!Evaluate(dataset.ground_truth, dataset.ground_truth_landmarks,
                 result.trajectory, nullptr, EvaluationOptions(), &evaluation,
                 &error)) {
