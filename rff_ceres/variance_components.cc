@@ -1,6 +1,5 @@
 #include "rff_ceres/variance_components.h"
 
-#include <algorithm>
 #include <random>
 #include <vector>
 
