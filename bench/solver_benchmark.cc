@@ -490,8 +490,10 @@ const Dataset& SeenThroughoutDataset(int poses) {
       std::exit(1);
     }
     key = poses;
-    if (const char* path = std::getenv("RFF_BENCH_DUMP")) {
-      WriteDataset(dataset, path, &error);
+    const char* path = std::getenv("RFF_BENCH_DUMP");
+    if (path != nullptr && !WriteDataset(dataset, path, &error)) {
+      fprintf(stderr, "RFF_BENCH_DUMP: %s\n", error.c_str());
+      std::exit(1);
     }
   }
   return dataset;

@@ -11,6 +11,7 @@ namespace {
 constexpr double kMaxDenseEntries = 33554432.0;
 constexpr int kChunkRows = 256;
 constexpr double kMaxLandmarkCondition = 1e8;
+constexpr double kMinSchurRcond = 1e-14;
 
 // Rows dense enough over the leading columns that dense products beat the
 // sparse J^T J: their nonzeros, squared and summed, above 1/64 of rows t^2
@@ -77,13 +78,20 @@ std::vector<double*> LandmarksLast(SlamProblem* problem, int* num_leading) {
   return order;
 }
 
-GaussNewtonSystem::GaussNewtonSystem(const RowMajorSparse& jacobian, int t) {
-  const Eigen::Index m = jacobian.cols() - t;
-  if (t <= kMaxDenseReducedSystem && m % 2 == 0 &&
-      double(t) * (t + m) <= kMaxDenseEntries && FormSchur(jacobian, t)) {
+bool SchurFormFits(int t, Eigen::Index m) {
+  return t >= 1 && t <= kMaxDenseReducedSystem && m % 2 == 0 &&
+         double(t) * (t + m) <= kMaxDenseEntries;
+}
+
+GaussNewtonSystem::GaussNewtonSystem(const RowMajorSparse& jacobian, int t,
+                                     bool sparse_fallback) {
+  if (SchurFormFits(t, jacobian.cols() - t) && FormSchur(jacobian, t)) {
     structured_ = true;
     return;
   }
+  b_ = Eigen::MatrixXd();
+  c_inverse_.clear();
+  if (!sparse_fallback) return;
   sparse_.compute(Eigen::SparseMatrix<double>(jacobian.transpose()) * jacobian);
   positive_definite_ =
       sparse_.info() == Eigen::Success && sparse_.vectorD().minCoeff() > 0.0;
@@ -135,8 +143,11 @@ bool GaussNewtonSystem::FormSchur(const RowMajorSparse& j, int t) {
   Eigen::MatrixXd s = LeadingGram(j, t);
   s.noalias() -= b_c_inverse * b_.transpose();
   schur_.compute(s);
-  positive_definite_ =
-      schur_.info() == Eigen::Success && schur_.vectorD().minCoeff() > 0.0;
+  // A zero pivot is not enough: S may be singular to rounding (rcond 1e-16),
+  // where its inverse is noise; a rank-revealing QR of J decides then.
+  positive_definite_ = schur_.info() == Eigen::Success &&
+                       schur_.vectorD().minCoeff() > 0.0 &&
+                       schur_.rcond() > kMinSchurRcond;
   return true;
 }
 

@@ -10,8 +10,9 @@
 // C_k^-1 + C_k^-1 B_k^T S^-1 B_k C_k^-1: linear in the number of landmarks
 // (the Schur complement of Ceres's own solvers, Triggs et al. 2000, 6.1).
 // This structured form is used while S (t x t) and B (t x 2L) fit in
-// memory (t <= kMaxDenseReducedSystem) and every C_k keeps 8 digits;
-// otherwise H is a sparse LDLT, for solves only.
+// memory (1 <= t <= kMaxDenseReducedSystem, t (t + m) <= 2^25 doubles for
+// S and B; their products need as much again) and every C_k keeps 8
+// digits; otherwise H is a sparse LDLT, for solves only.
 #ifndef RFF_CERES_GAUSS_NEWTON_SYSTEM_H_
 #define RFF_CERES_GAUSS_NEWTON_SYSTEM_H_
 
@@ -33,11 +34,17 @@ using RowMajorSparse = Eigen::SparseMatrix<double, Eigen::RowMajor>;
 // them. The column order GaussNewtonSystem expects.
 std::vector<double*> LandmarksLast(SlamProblem* problem, int* num_leading);
 
+// Whether the Schur form of t leading and m landmark columns fits (sizes
+// only; the structure and conditioning are checked on the Jacobian).
+bool SchurFormFits(int t, Eigen::Index m);
+
 class GaussNewtonSystem {
  public:
   // `jacobian`'s first `t` columns are the leading blocks, the rest the
-  // landmarks, two each.
-  GaussNewtonSystem(const RowMajorSparse& jacobian, int t);
+  // landmarks, two each. Without `sparse_fallback` a system that has not
+  // the Schur form is left unfactorised (positive_definite() false).
+  GaussNewtonSystem(const RowMajorSparse& jacobian, int t,
+                    bool sparse_fallback = true);
 
   // Whether the Schur form was built (covariances are available).
   bool structured() const { return structured_; }

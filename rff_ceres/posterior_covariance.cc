@@ -71,34 +71,34 @@ struct CovarianceBlocks {
 };
 
 // The blocks from the Schur form of J^T J (gauss_newton_system.h), linear
-// in the landmarks. Leaves `*used` false where the problem has not that
-// form (more than kMaxDenseReducedSystem trajectory parameters, a constant
-// block, a residual on two landmarks) or J^T J is not positive definite.
+// in the landmarks. False, with nothing filled, where the problem has not
+// that form (sizes, a constant block, a residual on two landmarks, an
+// ill-conditioned landmark) or J^T J is not positive definite.
 bool SchurCovariance(SlamProblem* problem, const TrajectoryModel& model,
                      const std::set<std::pair<int, int>>& block_pairs,
                      const std::vector<Landmark>& landmarks,
-                     CovarianceBlocks* blocks, bool* used, std::string* error) {
-  *used = false;
+                     CovarianceBlocks* blocks) {
   ceres::Problem* ceres_problem = problem->problem();
   int t = 0;
   const std::vector<double*> columns = LandmarksLast(problem, &t);
-  if (t > kMaxDenseReducedSystem) return true;
+  if (!SchurFormFits(t, ceres_problem->NumParameters() - t)) return false;
   for (double* block : columns) {
-    if (ceres_problem->IsParameterBlockConstant(block)) return true;
+    if (ceres_problem->IsParameterBlockConstant(block)) return false;
   }
   std::vector<ceres::ResidualBlockId> ids;
   ceres_problem->GetResidualBlocks(&ids);
   double cost = 0.0;
   Eigen::VectorXd residuals;
   RowMajorSparse jacobian;
-  if (!Linearize(ceres_problem, ids, &cost, &residuals, &jacobian, error,
+  std::string why_not;
+  if (!Linearize(ceres_problem, ids, &cost, &residuals, &jacobian, &why_not,
                  columns)) {
-    return false;
+    return false;  // Ceres evaluates it again and reports.
   }
   // Not structured or not positive definite: the QR of J (Ceres) decides,
   // and names the landmarks the data leave free.
-  const GaussNewtonSystem system(jacobian, t);
-  if (!system.structured() || !system.positive_definite()) return true;
+  const GaussNewtonSystem system(jacobian, t, /*sparse_fallback=*/false);
+  if (!system.structured() || !system.positive_definite()) return false;
   std::map<const double*, int> offset;
   int at = 0;
   for (double* block : columns) {
@@ -116,7 +116,6 @@ bool SchurCovariance(SlamProblem* problem, const TrajectoryModel& model,
     blocks->landmarks[l.id] =
         covariances[(offset.at(problem->landmark_block(l.id)) - t) / 2];
   }
-  *used = true;
   return true;
 }
 
@@ -207,12 +206,9 @@ bool ComputePosteriorCovariance(SlamProblem* problem,
   if (requests.empty()) return true;
 
   CovarianceBlocks blocks;
-  bool schur = false;
-  if (options.use_schur &&
-      !SchurCovariance(problem, model, block_pairs, *landmarks, &blocks, &schur,
-                       error)) {
-    return false;
-  }
+  const bool schur =
+      options.use_schur &&
+      SchurCovariance(problem, model, block_pairs, *landmarks, &blocks);
   if (!schur && !CeresCovariance(problem, model, block_pairs, requests,
                                  *landmarks, options, &blocks, error)) {
     return false;

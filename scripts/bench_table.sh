@@ -9,8 +9,8 @@
 # (SPARSE_SCHUR, ITERATIVE_SCHUR), each in a process of its own so that its
 # peak RSS is its own (a few minutes each). --solver_choice adds the
 # BM_DefaultSolver rows (default flags against each explicit linear solver,
-# 2k-1e5 poses), each in a process of its own under a 240 s timeout (about
-# 30 minutes). Extra flags go to rff_bench, e.g. --threads=2 or
+# 2k-1e5 poses), each in a process of its own under a 240 s timeout (30
+# rows: 30-40 minutes on 2 cores, at most 2 hours). Extra flags go to rff_bench, e.g. --threads=2 or
 # --benchmark_repetitions=3 (the tables then use the medians).
 set -euo pipefail
 repo=$(cd "$(dirname "$0")/.." && pwd)
@@ -53,12 +53,17 @@ if [ "$solver_choice" = 1 ]; then
       for solver in 0 1 2 3 4; do
         row="BM_DefaultSolver/prior:$prior/poses:$poses/solver:$solver"
         json="$out/choice_${prior}_${poses}_$solver.json"
-        if ! timeout "$timeout_seconds" "$bench" --solver_choice \
-            --benchmark_filter="$row/" --benchmark_out="$json" \
-            --benchmark_out_format=json ${extra[@]+"${extra[@]}"} >&2; then
-          # Killed by the timeout: a row that says so.
-          printf '{"benchmarks": [{"name": "%s", "run_name": "%s", "error_occurred": true, "error_message": "timeout %s s"}]}\n' \
-            "$row" "$row" "$timeout_seconds" > "$json"
+        status=0
+        timeout "$timeout_seconds" "$bench" --solver_choice \
+            ${extra[@]+"${extra[@]}"} --benchmark_filter="$row/" \
+            --benchmark_out="$json" --benchmark_out_format=json >&2 ||
+          status=$?
+        if [ $status != 0 ]; then
+          # Killed by the timeout (124) or failed: a row that says which.
+          message="exit $status"
+          [ $status = 124 ] && message="timeout $timeout_seconds s"
+          printf '{"benchmarks": [{"name": "%s", "run_name": "%s", "error_occurred": true, "error_message": "%s"}]}\n' \
+            "$row" "$row" "$message" > "$json"
         fi
       done
     done
@@ -164,8 +169,10 @@ if choice:
                 cells.append("not run")
             elif r.get("error_message", "").startswith("timeout"):
                 cells.append("> " + r["error_message"][8:])
-            elif r.get("error_occurred"):
+            elif "needs about" in r.get("error_message", ""):
                 cells.append("refused")
+            elif r.get("error_occurred"):
+                cells.append("failed: " + r.get("error_message", ""))
             else:
                 cells.append(f"{ms(r) / 1e3:.1f} s")
                 if name != "auto":

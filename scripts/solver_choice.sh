@@ -17,11 +17,14 @@ limit="${2:-120}"
   fail "TIMEOUT_SECONDS must be a positive integer, got '$limit'"
 [ -x "$build/rff_slam" ] && [ -x "$build/rff_simulate" ] ||
   fail "$build/rff_slam or rff_simulate not found: build first"
+for file in "$root/data/plaza1.rffd" "$root/data/mrclam6_robot1.rffd"; do
+  [ -f "$file" ] || fail "$file not found"
+done
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
 "$build/rff_simulate" --preset=laser_10hz --seed=1 \
-    --output="$work/laser_10hz_s1.rffd" > /dev/null 2>&1 ||
-  fail "rff_simulate failed"
+    --output="$work/laser_10hz_s1.rffd" > /dev/null 2> "$work/simulate.err" ||
+  fail "rff_simulate failed: $(cat "$work/simulate.err")"
 
 solvers=(auto SPARSE_NORMAL_CHOLESKY SPARSE_SCHUR ITERATIVE_SCHUR DENSE_SCHUR)
 header="| recording | prior |" rule="| --- | --- |"

@@ -173,15 +173,16 @@ void ExpectRedundanciesMatchTheExactTraces(const SlamOptions& given) {
   EXPECT_EQ(components[static_cast<int>(VarianceGroup::kFixed)].factor, 1.0);
 }
 
-// WNOA rows touch one or two states: H = J^T J as a sparse product.
+// WNOA rows touch one or two states: the Schur complement's A = J_t^T J_t
+// by the sparse product.
 TEST(VarianceComponentsTest, RedundanciesMatchTheExactTracesWnoa) {
   SlamOptions options;
   options.prior = "wnoa";
   ExpectRedundanciesMatchTheExactTraces(options);
 }
 
-// One global feature map: every row is dense over the 3 x 20 weights, so H^-1
-// goes through the landmarks' Schur complement.
+// One global feature map: every row is dense over the 3 x 20 weights, so
+// A = J_t^T J_t by dense products.
 TEST(VarianceComponentsTest, RedundanciesMatchTheExactTracesRffDenseRows) {
   SlamOptions options;
   options.prior = "rff";
