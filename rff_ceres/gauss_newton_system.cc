@@ -85,10 +85,14 @@ bool SchurFormFits(int t, Eigen::Index m) {
 
 GaussNewtonSystem::GaussNewtonSystem(const RowMajorSparse& jacobian, int t,
                                      bool sparse_fallback) {
-  if (SchurFormFits(t, jacobian.cols() - t) && FormSchur(jacobian, t)) {
+  // A Schur complement singular to rounding is retried as the sparse LDLT
+  // (solves only), as is a system without the form.
+  if (SchurFormFits(t, jacobian.cols() - t) && FormSchur(jacobian, t) &&
+      (positive_definite_ || !sparse_fallback)) {
     structured_ = true;
     return;
   }
+  positive_definite_ = false;
   b_ = Eigen::MatrixXd();
   c_inverse_.clear();
   if (!sparse_fallback) return;
