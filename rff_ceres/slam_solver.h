@@ -57,8 +57,10 @@ struct IncrementalOptions {
   double lag = 0.0;
 };
 
-// Each landmark's covariance costs column solves of the whole information
-// matrix (10000 landmarks on a 300-pose run: about 15 s).
+// Through Ceres's covariance (WNOA, or RFF without the Schur form of
+// posterior_covariance.cc) each landmark's covariance costs column solves of
+// the whole information matrix (10000 landmarks on a 300-pose run: about
+// 15 s); the Schur form is linear in the landmarks.
 inline constexpr std::size_t kMaxCovarianceLandmarks = 10000;
 
 // Refits of the spline mean stop changing it after a few rounds (III-B.2).
