@@ -154,7 +154,7 @@ void SlamProblem::AddCalibration(const char* kind, const Eigen::Vector2d& mean,
                                  const Eigen::Vector2d& upper, double* values) {
   Remember(problem_->AddResidualBlock(new DiagonalPriorCost(mean, sigma),
                                       nullptr, values),
-           {kind});
+           {kind, 0.0, 0.0, 0, false, /*has_time=*/false});
   for (int i = 0; i < 2; ++i) {
     problem_->SetParameterLowerBound(values, i, lower[i]);
     problem_->SetParameterUpperBound(values, i, upper[i]);
@@ -179,7 +179,7 @@ void SlamProblem::AddLandmarkPrior(const LandmarkPrior& p) {
   Remember(problem_->AddResidualBlock(
                new LandmarkPriorCost(Eigen::Vector2d(p.x, p.y), p.sigma),
                nullptr, landmark_block(p.id)),
-           {"landmark prior", 0.0, 0.0, p.id, true});
+           {"landmark prior", 0.0, 0.0, p.id, true, /*has_time=*/false});
 }
 
 void SlamProblem::AddPosePrior(const PosePrior& p) {
@@ -280,9 +280,7 @@ std::string SlamProblem::Describe(ceres::ResidualBlockId id) const {
   std::string text = std::string("the ") + s.kind + " residual";
   if (s.t1 != s.t0) {
     text += " from t = " + FormatNumber(s.t0) + " to " + FormatNumber(s.t1);
-  } else if (std::string(s.kind) != "landmark prior" &&
-             std::string(s.kind).find("calibration prior") ==
-                 std::string::npos) {
+  } else if (s.has_time) {
     text += " at t = " + FormatNumber(s.t0);
   }
   if (s.has_landmark) text += " of landmark " + std::to_string(s.landmark);
@@ -451,11 +449,11 @@ std::shared_ptr<ceres::ParameterBlockOrdering> SlamProblem::Ordering() {
                                 model_->IsSharedBlock(b) ? 2 : 1);
   }
   // A group of its own, so its place does not depend on its address.
-  if (options_.range_calibration.estimate) {
-    ordering->AddElementToGroup(range_calibration_.data(), 3);
-  }
-  if (problem_->HasParameterBlock(odometry_calibration_.data())) {
-    ordering->AddElementToGroup(odometry_calibration_.data(), 3);
+  for (double* calibration :
+       {range_calibration_.data(), odometry_calibration_.data()}) {
+    if (problem_->HasParameterBlock(calibration)) {
+      ordering->AddElementToGroup(calibration, 3);
+    }
   }
   return ordering;
 }

@@ -210,6 +210,7 @@ class SlamProblem {
     double t0 = 0.0, t1 = 0.0;
     LandmarkId landmark = 0;
     bool has_landmark = false;
+    bool has_time = true;  // Priors on landmarks and calibrations have none.
   };
   std::string Describe(ceres::ResidualBlockId id) const;
   // A calibration block `values` under the prior N(mean, diag(sigma^2)) (a
