@@ -195,17 +195,28 @@ SlamOptions BenchOptions(int num_features, double segment,
 
 // The datasets of the last (N, L), shared by the rows that differ in D,
 // segment or solver only.
-const Dataset& CachedDataset(int num_observations, int num_landmarks) {
-  static std::pair<int, int> key(-1, -1);
+const Dataset& CachedDataset(int num_observations, int num_landmarks,
+                             int per_step = kObservationsPerStep,
+                             bool landmark_seen_throughout = false) {
+  static std::tuple<int, int, int, bool> key(-1, -1, -1, false);
   static Dataset dataset;
-  if (key != std::make_pair(num_observations, num_landmarks)) {
+  const auto wanted = std::make_tuple(num_observations, num_landmarks, per_step,
+                                      landmark_seen_throughout);
+  if (key != wanted) {
     dataset = Dataset();
     std::string error;
-    if (!MakeDataset(num_observations, num_landmarks, &dataset, &error)) {
+    if (!MakeDataset(num_observations, num_landmarks, &dataset, &error,
+                     per_step, landmark_seen_throughout)) {
       fprintf(stderr, "MakeDataset: %s\n", error.c_str());
       std::exit(1);
     }
-    key = {num_observations, num_landmarks};
+    key = wanted;
+    // The row's data as .rffd, to rerun it with rff_slam --dataset.
+    const char* path = std::getenv("RFF_BENCH_DUMP");
+    if (path != nullptr && !WriteDataset(dataset, path, &error)) {
+      fprintf(stderr, "RFF_BENCH_DUMP: %s\n", error.c_str());
+      std::exit(1);
+    }
   }
   return dataset;
 }
@@ -476,29 +487,6 @@ void BM_FullSolve(benchmark::State& state) {
   state.SetLabel("SPARSE_SCHUR D=24 windows 50s/15s L=N/50, 10 iterations");
 }
 
-// N poses at 1 Hz with three range-bearing observations each: two of local
-// landmarks (L = N / 10) and one of a landmark seen from every pose.
-const Dataset& SeenThroughoutDataset(int poses) {
-  static int key = -1;
-  static Dataset dataset;
-  if (key != poses) {
-    dataset = Dataset();
-    std::string error;
-    if (!MakeDataset(3 * poses, poses / 10, &dataset, &error, /*per_step=*/3,
-                     /*landmark_seen_throughout=*/true)) {
-      fprintf(stderr, "MakeDataset: %s\n", error.c_str());
-      std::exit(1);
-    }
-    key = poses;
-    const char* path = std::getenv("RFF_BENCH_DUMP");
-    if (path != nullptr && !WriteDataset(dataset, path, &error)) {
-      fprintf(stderr, "RFF_BENCH_DUMP: %s\n", error.c_str());
-      std::exit(1);
-    }
-  }
-  return dataset;
-}
-
 const char* const kPriorNames[] = {"rff", "wnoa"};
 // Row 0 is the default; the others are the explicit choices it must match.
 const char* const kDefaultSolverRows[] = {"auto", "SPARSE_NORMAL_CHOLESKY",
@@ -512,7 +500,10 @@ void BM_DefaultSolver(benchmark::State& state) {
   const std::string prior = kPriorNames[state.range(0)];
   const int poses = static_cast<int>(state.range(1));
   const std::string solver = kDefaultSolverRows[state.range(2)];
-  const Dataset& dataset = SeenThroughoutDataset(poses);
+  // Three range-bearing observations per pose at 1 Hz: two of local
+  // landmarks (L = poses / 10), one of a landmark seen from every pose.
+  const Dataset& dataset = CachedDataset(3 * poses, poses / 10, /*per_step=*/3,
+                                         /*landmark_seen_throughout=*/true);
   SlamOptions options;
   options.prior = prior;
   options.solver.linear_solver = solver;
