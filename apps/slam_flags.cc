@@ -102,11 +102,12 @@ DEFINE_double(spline_smoothing, 0.98,
               "Smoothing parameter p of the spline mean (De Boor).");
 
 // Problem.
-DEFINE_string(loss, "cauchy",
-              "Robust loss on observations: none, huber, cauchy.");
+DEFINE_string(loss, "auto",
+              "Robust loss on observations: none, huber, cauchy, auto (cauchy, "
+              "then none where no residual is an outlier).");
 DEFINE_double(loss_scale, 2.0, "Robust loss scale, in sigmas.");
-DEFINE_string(odometry_loss, "cauchy",
-              "Robust loss on odometry residuals: none, huber, cauchy.");
+DEFINE_string(odometry_loss, "auto",
+              "Robust loss on odometry residuals: none, huber, cauchy, auto.");
 DEFINE_double(odometry_loss_scale, 2.0,
               "Robust odometry loss scale, in sigmas.");
 DEFINE_bool(estimate_range_calibration, false,

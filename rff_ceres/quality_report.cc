@@ -31,6 +31,17 @@ std::string Short(double value) {
 
 }  // namespace
 
+double OutlierLevel(int n) {
+  // P(|r| > level) = erfc(level / sqrt(2)), decreasing: bisection.
+  const double tail = kOutlierCountProbability / std::max(n, 1);
+  double low = 0.0, high = 40.0;
+  for (int i = 0; i < 100; ++i) {
+    const double mid = 0.5 * (low + high);
+    (std::erfc(mid / std::sqrt(2.0)) > tail ? low : high) = mid;
+  }
+  return high;
+}
+
 QualityReport AssessQuality(
     const std::map<std::string, std::vector<double>>& residuals,
     const SolveFacts& facts) {
@@ -47,6 +58,7 @@ QualityReport AssessQuality(
     int beyond = 0;
     for (const double r : values) {
       q.chi2_per_residual += r * r;
+      q.largest = std::max(q.largest, std::abs(r));
       if (std::abs(r) > 3.0) ++beyond;
     }
     q.chi2_per_residual /= q.residuals;

@@ -23,11 +23,17 @@ inline constexpr double kMaxShareBeyond3Sigma = 0.05;
 // when that many beyond 3 sigma would be rarer than this under N(0, 1).
 inline constexpr double kOutlierCountProbability = 1e-3;
 
+// The |r| that n draws of N(0, 1) all stay within with probability
+// 1 - kOutlierCountProbability (n * P(|r| > level) = that probability): a
+// residual beyond it is an outlier, not chance. About 5.3 for n = 10^4.
+double OutlierLevel(int n);
+
 struct ResidualKindQuality {
   std::string kind;  // "range", "odometry", "landmark prior", ...
   int residuals = 0;
   double chi2_per_residual = 0.0;     // sum(r^2) / n
   double share_beyond_3_sigma = 0.0;  // |r| > 3, as a fraction
+  double largest = 0.0;               // max |r|
 };
 
 struct QualityReport {

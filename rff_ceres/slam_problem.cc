@@ -29,11 +29,11 @@ bool CreateLoss(const LossOptions& options,
   }
   if (options.name == "huber") {
     loss->reset(new ceres::HuberLoss(options.scale));
-  } else if (options.name == "cauchy") {
+  } else if (options.name == "cauchy" || options.name == "auto") {
     loss->reset(new ceres::CauchyLoss(options.scale));
   } else {
-    *error =
-        "unknown loss '" + options.name + "' (expected none, huber or cauchy)";
+    *error = "unknown loss '" + options.name +
+             "' (expected none, huber, cauchy or auto)";
     return false;
   }
   return true;

@@ -23,9 +23,11 @@
 namespace rff {
 
 // Robust loss on the whitened observation residuals (range, bearing,
-// range-bearing); the scale is in units of sigma.
+// range-bearing); the scale is in units of sigma. "auto" is Cauchy for the
+// solve, then none where its residuals show no outlier (RunSlam): on Gaussian
+// data the quadratic loss is the MAP, and Cauchy's down-weighting costs.
 struct LossOptions {
-  std::string name = "none";  // none | huber | cauchy
+  std::string name = "none";  // none | huber | cauchy | auto
   double scale = 1.0;
 };
 
@@ -86,9 +88,9 @@ enum class VarianceGroup {
 inline constexpr int kNumVarianceGroups = 6;
 
 // Robust by default: real recordings carry outliers and heavy tails
-// (MRCLAM's commanded velocities, wrong associations); Cauchy at 2 sigma
-// leaves Gaussian data nearly as they are (docs/heldout.md has both).
-inline const LossOptions kDefaultLoss = {"cauchy", 2.0};
+// (MRCLAM's commanded velocities, wrong associations); "auto" then drops the
+// loss where the data turn out Gaussian (docs/heldout.md has both).
+inline const LossOptions kDefaultLoss = {"auto", 2.0};
 
 struct ProblemOptions {
   LossOptions loss = kDefaultLoss;

@@ -108,10 +108,17 @@ void PrintSlamSummary(const SlamOptions& options, const SlamResult& result,
          << options.incremental.every << " measurements), " << mean * 1e3
          << " ms mean, " << max * 1e3 << " ms max per update\n";
   }
-  *out << "  residuals   ";
+  *out << "  losses       observations " << options.problem.loss.name;
+  if (result.loss != options.problem.loss.name) *out << " -> " << result.loss;
+  *out << ", odometry " << options.problem.odometry_loss.name;
+  if (result.odometry_loss != options.problem.odometry_loss.name) {
+    *out << " -> " << result.odometry_loss;
+  }
+  *out << "\n  residuals   ";
   for (const ResidualKindQuality& q : result.quality.kinds) {
     *out << " " << q.kind << " chi2/n " << q.chi2_per_residual << " ("
-         << 100.0 * q.share_beyond_3_sigma << "% > 3 sigma);";
+         << 100.0 * q.share_beyond_3_sigma << "% > 3 sigma, largest "
+         << q.largest << ");";
   }
   *out << "\n  quality      " << QualityLine(result.quality) << "\n";
   if (!result.converged) {
@@ -174,6 +181,9 @@ void WriteSummaryJson(const SlamOptions& options, const SlamResult& result,
       << JsonString(options.problem.odometry_loss.name) << ",\n"
       << "  \"odometry_loss_scale\": "
       << FormatNumber(options.problem.odometry_loss.scale) << ",\n"
+      << "  \"loss_solved\": " << JsonString(result.loss) << ",\n"
+      << "  \"odometry_loss_solved\": " << JsonString(result.odometry_loss)
+      << ",\n"
       << "  \"linear_solver\": " << JsonString(result.linear_solver) << ",\n"
       << "  \"linear_solver_reason\": "
       << JsonString(result.linear_solver_reason) << ",\n"
@@ -217,7 +227,8 @@ void WriteSummaryJson(const SlamOptions& options, const SlamResult& result,
         << ": {\"count\": " << q.residuals
         << ", \"chi2_per_residual\": " << FormatNumber(q.chi2_per_residual)
         << ", \"share_beyond_3_sigma\": "
-        << FormatNumber(q.share_beyond_3_sigma) << "}";
+        << FormatNumber(q.share_beyond_3_sigma)
+        << ", \"largest\": " << FormatNumber(q.largest) << "}";
   }
   out << "\n  },\n"
       << "  \"incremental_every\": " << options.incremental.every << ",\n"

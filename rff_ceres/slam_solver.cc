@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <fstream>
+#include <initializer_list>
 #include <limits>
 #include <set>
 
@@ -664,6 +665,34 @@ bool LearnPriorScales(const Dataset& dataset,
   return true;
 }
 
+// Settles "auto" losses (slam_problem.h) after a robust solve: a loss whose
+// residual kinds all stay within the outlier level of their count becomes
+// "none", the rest "cauchy". Returns whether any became "none".
+bool SettleAutoLosses(SlamProblem* problem, ProblemOptions* options) {
+  const std::map<std::string, std::vector<double>> residuals =
+      problem->WhitenedResidualsByKind();
+  auto clean = [&](std::initializer_list<const char*> kinds) {
+    for (const char* kind : kinds) {
+      const auto it = residuals.find(kind);
+      if (it == residuals.end()) continue;
+      const double level = OutlierLevel(static_cast<int>(it->second.size()));
+      for (const double r : it->second) {
+        if (!(std::abs(r) <= level)) return false;
+      }
+    }
+    return true;
+  };
+  bool dropped = false;
+  auto settle = [&](bool is_clean, LossOptions* loss) {
+    if (loss->name != "auto") return;
+    loss->name = is_clean ? "none" : "cauchy";
+    dropped = dropped || is_clean;
+  };
+  settle(clean({"range", "bearing", "range-bearing"}), &options->loss);
+  settle(clean({"odometry"}), &options->odometry_loss);
+  return dropped;
+}
+
 // Adds the covariance of a mean that is itself an estimate (the WNOA
 // solve, at the same output times) to that of the correction around it: the
 // RFF weights then carry what the data leave after the mean (about nothing,
@@ -754,6 +783,7 @@ bool RunSlamAtOrigin(const Dataset& dataset, const SlamOptions& options,
   // as its initial value without odometry, where the localisation pilot
   // has no motion model to bridge gaps between fixes.
   SlamOptions warm = options;
+  ProblemOptions settled_losses = options.problem;
   // A "wnoa" mean is an estimate: its covariance joins the correction's.
   SlamResult wnoa_mean_solve;
   const auto mean_start = std::chrono::steady_clock::now();
@@ -767,6 +797,12 @@ bool RunSlamAtOrigin(const Dataset& dataset, const SlamOptions& options,
     if (!SolveWnoa(dataset, options, wnoa_mean && options.compute_covariance,
                    &wnoa, error)) {
       return false;
+    }
+    // The same data: a loss the WNOA solve found no outlier for is dropped
+    // here too. Its outliers may be its own misfit: the RFF solve decides.
+    if (wnoa.loss == "none") settled_losses.loss.name = "none";
+    if (wnoa.odometry_loss == "none") {
+      settled_losses.odometry_loss.name = "none";
     }
     if (wnoa_mean) {
       mean = std::make_shared<PiecewiseLinearMean>(wnoa.trajectory);
@@ -815,6 +851,8 @@ bool RunSlamAtOrigin(const Dataset& dataset, const SlamOptions& options,
     initial.push_back({t, pose.x(), pose.y(), pose.z()});
   }
   SlamOptions settled = options;
+  settled.problem.loss = settled_losses.loss;
+  settled.problem.odometry_loss = settled_losses.odometry_loss;
   const bool search =
       options.learn_hyperparameters == "on" ||
       (options.learn_hyperparameters == "auto" && dataset.odometry.empty());
@@ -844,7 +882,7 @@ bool RunSlamAtOrigin(const Dataset& dataset, const SlamOptions& options,
     // their starting hyperparameters.
     const std::vector<TimedPose>& about =
         warm.initial_poses.empty() ? initial : warm.initial_poses;
-    if (!LearnHyperparameters(resolved, mean, about, landmarks, options.problem,
+    if (!LearnHyperparameters(resolved, mean, about, landmarks, settled.problem,
                               options.learning, &settled.trajectory,
                               &result->learning, error)) {
       *error = "learning the hyperparameters: " + *error;
@@ -880,12 +918,23 @@ bool RunSlamAtOrigin(const Dataset& dataset, const SlamOptions& options,
   } else if (!SolveBatch(dataset, settled, ceres_options, model.get(),
                          &landmarks, initial_extent, &problem, result, error)) {
     return false;
+  } else if (SettleAutoLosses(problem.get(), &settled.problem) &&
+             !SolveBatch(dataset, settled, ceres_options, model.get(),
+                         &landmarks, initial_extent, &problem, result, error)) {
+    return false;
   } else if (((options.prior == "wnoa" && search) || correction) &&
              !LearnPriorScales(dataset, mean, ceres_options, initial_extent,
                                &settled, &model, &landmarks, &problem, result,
                                error)) {
     return false;
   }
+  // Incremental updates keep an "auto" loss robust throughout.
+  for (LossOptions* loss :
+       {&settled.problem.loss, &settled.problem.odometry_loss}) {
+    if (loss->name == "auto") loss->name = "cauchy";
+  }
+  result->loss = settled.problem.loss.name;
+  result->odometry_loss = settled.problem.odometry_loss.name;
   result->wnoa_options = settled.wnoa;
   if (const auto* features =
           dynamic_cast<const FeatureTrajectory*>(InnerModel(model.get()))) {

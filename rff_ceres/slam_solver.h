@@ -153,6 +153,10 @@ struct SlamResult {
   Eigen::Vector2d odometry_calibration = Eigen::Vector2d(1.0, 1.0);
   // The whitened residuals at the solution and the verdict on them.
   QualityReport quality;
+  // The observation and odometry losses as solved: an "auto" loss settles on
+  // "cauchy" or, where its residuals show no outlier, "none".
+  std::string loss;
+  std::string odometry_loss;
 };
 
 // The prior mean "auto" stands for on `dataset`: for the RFF prior in batch

@@ -1,5 +1,7 @@
 #include "rff_ceres/quality_report.h"
 
+#include <algorithm>
+#include <cmath>
 #include <random>
 
 #include "gmock/gmock.h"
@@ -37,6 +39,19 @@ TEST(QualityReportTest, ResidualsAsTheSigmasPromiseAreOk) {
   EXPECT_EQ(report.kinds[1].kind, "range");
   EXPECT_NEAR(report.kinds[1].chi2_per_residual, 1.0, 0.06);
   EXPECT_NEAR(report.kinds[1].share_beyond_3_sigma, 0.0027, 0.002);
+  const std::vector<double> ranges = StandardNormal(5000, 1.0, 1);
+  double largest = 0.0;
+  for (const double r : ranges) largest = std::max(largest, std::abs(r));
+  EXPECT_EQ(report.kinds[1].largest, largest);
+  EXPECT_LT(largest, OutlierLevel(5000));
+}
+
+// n * P(|r| > level) = 1e-3 for r ~ N(0, 1): erfc(level / sqrt(2)) = 1e-3
+// at 3.2905, 1e-7 at 5.3267.
+TEST(QualityReportTest, OutlierLevelIsTheGaussianTailOfTheCount) {
+  EXPECT_NEAR(OutlierLevel(1), 3.2905, 1e-4);
+  EXPECT_NEAR(OutlierLevel(10000), 5.3267, 1e-4);
+  EXPECT_NEAR(OutlierLevel(0), OutlierLevel(1), 1e-12);
 }
 
 TEST(QualityReportTest, ResidualsThreeTimesTheirSigmaAreSuspect) {

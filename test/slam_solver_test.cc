@@ -197,9 +197,10 @@ INSTANTIATE_TEST_SUITE_P(
                     o->solver.preconditioner = "SCHUR_JACOBI";
                   },
                   "CGNR supports the preconditioners IDENTITY and JACOBI"},
-        BadOption{"UnknownLoss",
-                  [](SlamOptions* o) { o->problem.loss.name = "tukey"; },
-                  "unknown loss 'tukey'"},
+        BadOption{
+            "UnknownLoss",
+            [](SlamOptions* o) { o->problem.loss.name = "tukey"; },
+            "unknown loss 'tukey' (expected none, huber, cauchy or auto)"},
         BadOption{"UnknownOdometryLoss",
                   [](SlamOptions* o) { o->problem.odometry_loss.name = "l1"; },
                   "odometry loss: unknown loss 'l1'"},
@@ -277,6 +278,8 @@ TEST(SlamSolverTest, IncrementalModeTracksTheBatchSolution) {
   ASSERT_TRUE(Simulate(sim, &dataset, &error)) << error;
   SlamOptions options = PaperSolverOptions();
   options.prior_mean = "odometry";  // No landmark priors to localise against.
+  // The same losses in both: incremental updates keep "auto" robust.
+  options.problem.loss.name = options.problem.odometry_loss.name = "cauchy";
   SlamResult batch;
   ASSERT_TRUE(RunSlam(dataset, options, &batch, &error)) << error;
   EXPECT_TRUE(batch.updates.empty());
@@ -391,6 +394,58 @@ TEST(SlamSolverTest, RobustOdometryLossRejectsSlippingRecords) {
   const double robust_ape = ApeTranslation(dataset, robust);
   EXPECT_LT(robust_ape, 0.5 * plain_ape) << robust_ape << " vs " << plain_ape;
   EXPECT_LT(robust_ape, 1.5);
+}
+
+// The default "auto" losses: Cauchy for the first solve, then none for the
+// kinds whose residuals show no outlier; the solution is then the quadratic
+// MAP, as with the loss off from the start.
+TEST(SlamSolverTest, AutoLossIsDroppedOnlyWhereNoResidualIsAnOutlier) {
+  SimulationOptions sim = PaperOptions(23);
+  sim.num_landmarks = 20;
+  Dataset dataset;
+  std::string error;
+  ASSERT_TRUE(Simulate(sim, &dataset, &error)) << error;
+  SlamOptions options = PaperSolverOptions();
+  ASSERT_EQ(options.problem.loss.name, "auto");
+  ASSERT_EQ(options.problem.odometry_loss.name, "auto");
+  SlamResult gaussian;
+  ASSERT_TRUE(RunSlam(dataset, options, &gaussian, &error)) << error;
+  EXPECT_EQ(gaussian.loss, "none");
+  EXPECT_EQ(gaussian.odometry_loss, "none");
+  SlamOptions quadratic = options;
+  quadratic.problem.loss = quadratic.problem.odometry_loss = {"none", 1.0};
+  SlamResult reference;
+  ASSERT_TRUE(RunSlam(dataset, quadratic, &reference, &error)) << error;
+  EXPECT_NEAR(ApeTranslation(dataset, gaussian),
+              ApeTranslation(dataset, reference), 1e-4);
+
+  // One range-bearing record 20 m long: the observation loss stays.
+  Dataset one_outlier = dataset;
+  for (Observation& o : one_outlier.observations) {
+    if (o.HasRange()) {
+      o.range += 20.0;
+      break;
+    }
+  }
+  SlamResult robust;
+  ASSERT_TRUE(RunSlam(one_outlier, options, &robust, &error)) << error;
+  EXPECT_EQ(robust.loss, "cauchy");
+  EXPECT_EQ(robust.odometry_loss, "none");
+
+  // One odometry record that slips 2 m and 0.2 rad (40 and 20 sigma): the
+  // odometry loss stays.
+  Dataset one_slip = dataset;
+  one_slip.odometry[10].dx += 2.0;
+  one_slip.odometry[10].dtheta += 0.2;
+  ASSERT_TRUE(RunSlam(one_slip, options, &robust, &error)) << error;
+  EXPECT_EQ(robust.loss, "none");
+  EXPECT_EQ(robust.odometry_loss, "cauchy");
+
+  // Incremental updates keep it robust.
+  options.incremental.every = 50;
+  ASSERT_TRUE(RunSlam(dataset, options, &robust, &error)) << error;
+  EXPECT_EQ(robust.loss, "cauchy");
+  EXPECT_EQ(robust.odometry_loss, "cauchy");
 }
 
 TEST(SlamSolverTest, IncrementalModeRejectsOuterRounds) {
