@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <map>
 #include <set>
 #include <utility>
@@ -10,6 +11,7 @@
 #include "ceres/covariance.h"
 #include "rff_ceres/gauss_newton_system.h"
 #include "rff_ceres/io/text_parser.h"
+#include "rff_ceres/selected_inverse.h"
 #include "rff_ceres/variance_components.h"
 
 namespace rff {
@@ -119,6 +121,69 @@ bool SchurCovariance(SlamProblem* problem, const TrajectoryModel& model,
   return true;
 }
 
+// The same blocks from the selected inverse of a sparse Cholesky of J^T J
+// (selected_inverse.h), where every block needed lies on its factor's
+// pattern. False, with nothing filled, where J^T J is not positive definite,
+// the factor is too large or a block is off its pattern.
+constexpr std::int64_t kMaxSelectedInverseNonzeros = std::int64_t{1} << 25;
+bool SelectedInverseCovariance(SlamProblem* problem,
+                               const TrajectoryModel& model,
+                               const std::set<std::pair<int, int>>& block_pairs,
+                               const std::vector<Landmark>& landmarks,
+                               CovarianceBlocks* blocks) {
+  ceres::Problem* ceres_problem = problem->problem();
+  int t = 0;
+  const std::vector<double*> columns = LandmarksLast(problem, &t);
+  std::map<const double*, int> offset;
+  int at = 0;
+  for (double* block : columns) {
+    if (ceres_problem->IsParameterBlockConstant(block)) return false;
+    offset[block] = at;
+    at += ceres_problem->ParameterBlockSize(block);
+  }
+  std::vector<ceres::ResidualBlockId> ids;
+  ceres_problem->GetResidualBlocks(&ids);
+  double cost = 0.0;
+  Eigen::VectorXd residuals;
+  RowMajorSparse jacobian;
+  std::string why_not;
+  if (!Linearize(ceres_problem, ids, &cost, &residuals, &jacobian, &why_not,
+                 columns)) {
+    return false;
+  }
+  const Eigen::SparseMatrix<double> information =
+      jacobian.transpose() * jacobian;
+  SelectedInverse inverse;
+  if (!inverse.Compute(information, kMaxSelectedInverseNonzeros)) return false;
+  auto fill = [&](const double* a, const double* b, Eigen::MatrixXd* block) {
+    const int rows = ceres_problem->ParameterBlockSize(a);
+    const int cols = ceres_problem->ParameterBlockSize(b);
+    block->resize(rows, cols);
+    for (int i = 0; i < rows; ++i) {
+      for (int j = 0; j < cols; ++j) {
+        if (!inverse.Entry(offset.at(a) + i, offset.at(b) + j,
+                           &(*block)(i, j))) {
+          return false;
+        }
+      }
+    }
+    return true;
+  };
+  CovarianceBlocks filled;
+  Eigen::MatrixXd block;
+  for (const auto& [a, b] : block_pairs) {
+    if (!fill(model.block(a), model.block(b), &block)) return false;
+    filled.trajectory[{a, b}] = block;
+  }
+  for (const Landmark& l : landmarks) {
+    const double* parameters = problem->landmark_block(l.id);
+    if (!fill(parameters, parameters, &block)) return false;
+    filled.landmarks[l.id] = block;
+  }
+  *blocks = std::move(filled);
+  return true;
+}
+
 // The same blocks from ceres::Covariance with `options.algorithm`.
 bool CeresCovariance(
     SlamProblem* problem, const TrajectoryModel& model,
@@ -160,9 +225,8 @@ bool ComputePosteriorCovariance(SlamProblem* problem,
                                 const CovarianceOptions& options,
                                 std::vector<Eigen::Matrix3d>* pose_covariances,
                                 std::vector<Landmark>* landmarks,
-                                std::string* error, bool* used_schur) {
+                                std::string* error, CovarianceMethod* method) {
   pose_covariances->clear();
-  if (used_schur != nullptr) *used_schur = false;
   if (options.num_threads < 1) {
     *error = "posterior covariance: num_threads must be >= 1";
     return false;
@@ -206,14 +270,21 @@ bool ComputePosteriorCovariance(SlamProblem* problem,
   if (requests.empty()) return true;
 
   CovarianceBlocks blocks;
-  const bool schur =
-      options.use_schur &&
-      SchurCovariance(problem, model, block_pairs, *landmarks, &blocks);
-  if (!schur && !CeresCovariance(problem, model, block_pairs, requests,
-                                 *landmarks, options, &blocks, error)) {
-    return false;
+  CovarianceMethod used = CovarianceMethod::kSchur;
+  if (!options.use_schur ||
+      !SchurCovariance(problem, model, block_pairs, *landmarks, &blocks)) {
+    used = CovarianceMethod::kSelectedInverse;
+    if (!options.use_selected_inverse ||
+        !SelectedInverseCovariance(problem, model, block_pairs, *landmarks,
+                                   &blocks)) {
+      used = CovarianceMethod::kCeres;
+      if (!CeresCovariance(problem, model, block_pairs, requests, *landmarks,
+                           options, &blocks, error)) {
+        return false;
+      }
+    }
   }
-  if (used_schur != nullptr) *used_schur = schur;
+  if (method != nullptr) *method = used;
   const auto& sigma = blocks.trajectory;
   pose_covariances->reserve(times.size());
   for (std::size_t k = 0; k < times.size(); ++k) {

@@ -21,11 +21,22 @@
 
 namespace rff {
 
-struct CovarianceOptions {
+// How the covariance was computed, the first that applies in this order.
+enum class CovarianceMethod {
   // The Schur form of J^T J (gauss_newton_system.h: linear in the
   // landmarks) where the trajectory has at most kMaxDenseReducedSystem
-  // parameters; ceres::Covariance with `algorithm` otherwise.
+  // parameters.
+  kSchur,
+  // The inverse on the pattern of a sparse Cholesky factor of J^T J
+  // (selected_inverse.h: linear in the length of a banded run, e.g. WNOA).
+  kSelectedInverse,
+  // ceres::Covariance with CovarianceOptions::algorithm.
+  kCeres,
+};
+
+struct CovarianceOptions {
   bool use_schur = true;
+  bool use_selected_inverse = true;
   // SPARSE_QR (SuiteSparseQR) scales to long runs but needs a full-rank
   // Jacobian; DENSE_SVD is O(n^3) in the number of parameters.
   ceres::CovarianceAlgorithmType algorithm = ceres::SPARSE_QR;
@@ -39,14 +50,15 @@ struct CovarianceOptions {
 // by id to the problem's landmark blocks; has_covariance set). Returns false
 // with a message when the information matrix is singular (naming the
 // landmarks that the data leave unconstrained) or the result is not finite.
-// `used_schur`, when given, says whether the Schur form was used.
+// `method`, when given, says how it was computed.
 bool ComputePosteriorCovariance(SlamProblem* problem,
                                 const TrajectoryModel& model,
                                 const std::vector<double>& times,
                                 const CovarianceOptions& options,
                                 std::vector<Eigen::Matrix3d>* pose_covariances,
                                 std::vector<Landmark>* landmarks,
-                                std::string* error, bool* used_schur = nullptr);
+                                std::string* error,
+                                CovarianceMethod* method = nullptr);
 
 // The same with the default CovarianceOptions.
 bool ComputePosteriorCovariance(SlamProblem* problem,

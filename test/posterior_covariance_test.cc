@@ -16,6 +16,7 @@
 #include "rff_ceres/io/text_parser.h"
 #include "rff_ceres/simulate.h"
 #include "rff_ceres/slam_solver.h"
+#include "rff_ceres/wnoa_trajectory.h"
 #include "test/synthetic_options.h"
 
 namespace rff {
@@ -72,10 +73,12 @@ PosePrior PriorAt(double t, double sigma_xy, double sigma_theta) {
   return p;
 }
 
-// ceres::Covariance with `algorithm`, never the Schur form.
+// ceres::Covariance with `algorithm`, never the Schur form or the selected
+// inverse.
 CovarianceOptions WithAlgorithm(ceres::CovarianceAlgorithmType algorithm) {
   CovarianceOptions options;
   options.use_schur = false;
+  options.use_selected_inverse = false;
   options.algorithm = algorithm;
   options.num_threads = 1;
   return options;
@@ -146,17 +149,15 @@ TEST(PosteriorCovarianceTest, SingleRangeLeavesALandmarkUnconstrained) {
   std::vector<Landmark> landmarks(2);
   landmarks[0].id = 5;
   landmarks[1].id = 7;
-  // The default tries the Schur form first: landmark 5's block is singular,
-  // so SuiteSparseQR decides, with the same message.
+  // The default tries the Schur form and the selected inverse first:
+  // landmark 5's block is singular, so SuiteSparseQR decides, with the same
+  // message.
   for (const CovarianceOptions& options :
        {WithAlgorithm(ceres::SPARSE_QR), WithAlgorithm(ceres::DENSE_SVD),
         CovarianceOptions()}) {
     std::vector<Eigen::Matrix3d> covariances;
-    bool used_schur = true;
     EXPECT_FALSE(ComputePosteriorCovariance(&problem, model, {0.5}, options,
-                                            &covariances, &landmarks, &error,
-                                            &used_schur));
-    EXPECT_FALSE(used_schur);
+                                            &covariances, &landmarks, &error));
     EXPECT_THAT(error,
                 HasSubstr("the information matrix J^T J is singular; the "
                           "data do not fix the position of landmark 5 ("));
@@ -214,20 +215,23 @@ TEST(PosteriorCovarianceTest, MatchesTheDenseInverseWithWindowedWeights) {
   ASSERT_TRUE(problem.Build(dataset, initial, &error)) << error;
   std::vector<double> times;
   for (int k = 0; k < 118; ++k) times.push_back(0.5 * k + 0.25);
-  // The Schur form (the default) and SuiteSparseQR.
-  CovarianceOptions schur = WithAlgorithm(ceres::SPARSE_QR);
-  schur.use_schur = true;
-  for (const CovarianceOptions& covariance_options :
-       {schur, WithAlgorithm(ceres::SPARSE_QR)}) {
-    SCOPED_TRACE(covariance_options.use_schur ? "schur" : "sparse QR");
+  // The Schur form (the default), the selected inverse and SuiteSparseQR.
+  CovarianceOptions selected = WithAlgorithm(ceres::SPARSE_QR);
+  selected.use_selected_inverse = true;
+  const std::pair<CovarianceOptions, CovarianceMethod> methods[] = {
+      {CovarianceOptions(), CovarianceMethod::kSchur},
+      {selected, CovarianceMethod::kSelectedInverse},
+      {WithAlgorithm(ceres::SPARSE_QR), CovarianceMethod::kCeres}};
+  for (const auto& [covariance_options, expected_method] : methods) {
+    SCOPED_TRACE(static_cast<int>(expected_method));
     for (Landmark& l : landmarks) l.has_covariance = false;
     std::vector<Eigen::Matrix3d> covariances;
-    bool used_schur = false;
+    CovarianceMethod method = CovarianceMethod::kCeres;
     ASSERT_TRUE(ComputePosteriorCovariance(&problem, *model, times,
                                            covariance_options, &covariances,
-                                           &landmarks, &error, &used_schur))
+                                           &landmarks, &error, &method))
         << error;
-    EXPECT_EQ(used_schur, covariance_options.use_schur);
+    EXPECT_EQ(method, expected_method);
 
     // Dense J over [trajectory blocks..., landmark blocks...].
     std::vector<double*> blocks;
@@ -282,6 +286,58 @@ TEST(PosteriorCovarianceTest, MatchesTheDenseInverseWithWindowedWeights) {
       EXPECT_NEAR(landmarks[k].sxy, expected(0, 1), 1e-9 * expected.norm());
       EXPECT_NEAR(landmarks[k].syy, expected(1, 1), 1e-9 * expected.norm());
     }
+  }
+}
+
+// A WNOA run is banded: too many states for the Schur form, and the
+// selected inverse gives what SuiteSparseQR gives.
+TEST(PosteriorCovarianceTest, WnoaRunUsesTheSelectedInverse) {
+  SimulationOptions sim = PaperOptions(6);
+  sim.num_steps = 400;
+  sim.num_landmarks = 10;
+  Dataset dataset;
+  std::string error;
+  ASSERT_TRUE(Simulate(sim, &dataset, &error)) << error;
+  std::vector<double> times;
+  for (const TimedPose& p : dataset.ground_truth) times.push_back(p.t);
+  std::unique_ptr<WnoaTrajectory> model = WnoaTrajectory::Create(
+      WnoaOptions(),
+      std::make_shared<PiecewiseLinearMean>(dataset.ground_truth), times,
+      &error);
+  ASSERT_NE(model, nullptr) << error;
+  ASSERT_GT(model->num_blocks() * WnoaTrajectory::kStateSize, 2000);
+  std::map<LandmarkId, Eigen::Vector2d> initial;
+  std::vector<Landmark> landmarks;
+  for (const Landmark& l : dataset.ground_truth_landmarks) {
+    initial[l.id] = Eigen::Vector2d(l.x, l.y);
+    landmarks.push_back(l);
+  }
+  SlamProblem problem(model.get(), ProblemOptions());
+  ASSERT_TRUE(problem.Build(dataset, initial, &error)) << error;
+  std::vector<double> output;
+  for (int k = 0; k < 200; ++k) output.push_back(1.7 * k + 0.3);
+  std::vector<Eigen::Matrix3d> selected, reference;
+  std::vector<Landmark> selected_landmarks = landmarks;
+  CovarianceMethod method = CovarianceMethod::kCeres;
+  ASSERT_TRUE(ComputePosteriorCovariance(&problem, *model, output,
+                                         CovarianceOptions(), &selected,
+                                         &selected_landmarks, &error, &method))
+      << error;
+  EXPECT_EQ(method, CovarianceMethod::kSelectedInverse);
+  ASSERT_TRUE(ComputePosteriorCovariance(
+      &problem, *model, output, WithAlgorithm(ceres::SPARSE_QR), &reference,
+      &landmarks, &error, &method))
+      << error;
+  EXPECT_EQ(method, CovarianceMethod::kCeres);
+  for (std::size_t k = 0; k < output.size(); ++k) {
+    EXPECT_LT((selected[k] - reference[k]).norm(), 1e-8 * reference[k].norm())
+        << "t = " << output[k];
+  }
+  for (std::size_t k = 0; k < landmarks.size(); ++k) {
+    EXPECT_NEAR(selected_landmarks[k].sxx, landmarks[k].sxx,
+                1e-8 * landmarks[k].sxx);
+    EXPECT_NEAR(selected_landmarks[k].sxy, landmarks[k].sxy,
+                1e-8 * landmarks[k].sxx);
   }
 }
 

@@ -1,0 +1,46 @@
+// Entries of the inverse of a sparse symmetric positive definite matrix H on
+// the pattern of its Cholesky factor, P H P^T = L L^T (Takahashi, Fagan and
+// Chin 1973; Erisman and Tinney 1975). With Z = H^-1 in the permuted order,
+// for every i >= j in the pattern of L, from the last column to the first,
+//
+//   Z_ij = delta_ij / L_jj^2 - (1 / L_jj) sum_{k > j, L_kj != 0} Z_ik L_kj,
+//
+// and every Z_ik the sum needs lies on that pattern too (the rows of a column
+// of L form a clique of it). The pattern holds that of H, so each diagonal
+// block and each pair of blocks that share a residual is available, at a
+// cost of sum_j nnz(L_:j)^2: linear in the length of a banded run.
+#ifndef RFF_CERES_SELECTED_INVERSE_H_
+#define RFF_CERES_SELECTED_INVERSE_H_
+
+#include <cstdint>
+#include <vector>
+
+#include "Eigen/SparseCore"
+
+namespace rff {
+
+class SelectedInverse {
+ public:
+  // Factorises `h` (symmetric; its lower triangle is read) and computes the
+  // inverse on the factor's pattern. False when `h` is not positive definite
+  // or the factor has more than `max_factor_nonzeros` entries.
+  bool Compute(const Eigen::SparseMatrix<double>& h,
+               std::int64_t max_factor_nonzeros);
+
+  // (H^-1)_ij in the original order; false when (i, j) is outside the
+  // computed pattern.
+  bool Entry(int i, int j, double* value) const;
+
+ private:
+  // Position of row `row` in column `column` of the factor's pattern, or -1.
+  std::int64_t Find(int row, int column) const;
+
+  std::vector<int> permutation_;  // Original index -> factor index.
+  std::vector<std::int64_t> column_starts_;
+  std::vector<int> rows_;  // Ascending within each column.
+  std::vector<double> inverse_;
+};
+
+}  // namespace rff
+
+#endif  // RFF_CERES_SELECTED_INVERSE_H_
