@@ -3,21 +3,28 @@
 # score datasets, solves each with rff_slam's DEFAULT flags under both
 # priors, scores them, and prints one Markdown row per dataset and a summary
 # per split.
-#   scripts/heldout.sh BUILD_DIR OUT_DIR [--quick]
+#   scripts/heldout.sh BUILD_DIR OUT_DIR [--quick] [--consistency]
 # Builds the tools in BUILD_DIR first (Release). Needs ../shared/data
 # beside the repository. Writes OUT_DIR/data (inputs),
 # OUT_DIR/runs (every output and log), OUT_DIR/heldout.csv and
 # OUT_DIR/heldout.md. --quick: one dataset of each kind, a smoke test.
+# --consistency: every solve also writes its pose covariances, and the
+# table gains the mean position NEES and the 95%-ellipse coverage (the
+# times then include the covariance).
 set -euo pipefail
 
 fail() { echo "heldout: error: $*" >&2; exit 1; }
 
-[ $# -ge 2 ] && [ $# -le 3 ] || fail "usage: scripts/heldout.sh BUILD_DIR OUT_DIR [--quick]"
-quick=0
-if [ $# -eq 3 ]; then
-  [ "$3" = --quick ] || fail "unknown option '$3' (expected --quick)"
-  quick=1
-fi
+usage="usage: scripts/heldout.sh BUILD_DIR OUT_DIR [--quick] [--consistency]"
+[ $# -ge 2 ] && [ $# -le 4 ] || fail "$usage"
+quick=0 consistency=0
+for option in "${@:3}"; do
+  case "$option" in
+    --quick) quick=1 ;;
+    --consistency) consistency=1 ;;
+    *) fail "unknown option '$option' (expected --quick or --consistency)" ;;
+  esac
+done
 root="$(cd "$(dirname "$0")/.." && pwd)"
 shared="$root/../shared/data"
 [ -d "$shared" ] || fail "$shared not found: the protocol needs ../shared/data (the raw datasets) beside the repository"
@@ -173,6 +180,11 @@ solve() {
   local extra=() rc=0 kernel
   kernel="$(truth_kernel "$file")"
   if [ "$prior" = rff ] && [ -n "$kernel" ]; then extra=(--kernel="$kernel"); fi
+  local covariance=()
+  if [ "$consistency" = 1 ]; then
+    extra+=(--output_covariance="$base.cov")
+    covariance=(--covariance="$base.cov")
+  fi
   /usr/bin/time -f %e -o "$base.time" timeout 300 "$build/rff_slam" \
       --dataset="$file" --prior="$prior" ${extra[@]+"${extra[@]}"} \
       --output_trajectory="$base.tum" --output_landmarks="$base.landmarks" \
@@ -180,8 +192,9 @@ solve() {
   echo "$rc" > "$base.rc"
   if [ "$rc" = 0 ]; then
     "$build/rff_evaluate" --dataset="$file" --trajectory="$base.tum" \
-        --landmarks="$base.landmarks" --json="$base.eval.json" \
-        >> "$base.log" 2>&1 || echo "evaluate failed" >> "$base.log"
+        --landmarks="$base.landmarks" ${covariance[@]+"${covariance[@]}"} \
+        --json="$base.eval.json" >> "$base.log" 2>&1 ||
+      echo "evaluate failed" >> "$base.log"
   fi
 }
 
@@ -222,10 +235,14 @@ wait
 # ---------------------------------------------------------------------------
 # (d) Table, summaries, CSV and Markdown.
 python3 - "$manifest" "$runs" "$out" "$build" "$root" \
-    $((SECONDS - start_seconds)) <<'EOF'
+    $((SECONDS - start_seconds)) "$consistency" <<'EOF'
 import csv, json, os, re, statistics, subprocess, sys
 
-manifest, runs, out, build, root, seconds = sys.argv[1:]
+manifest, runs, out, build, root, seconds, consistency = sys.argv[1:]
+consistency = consistency == "1"
+# The bands a consistent covariance falls in (mean position NEES, ideal 2;
+# share of poses inside their 95% ellipse).
+NEES_BAND, COVERAGE_BAND = (1.5, 3.0), (0.90, 0.98)
 
 def read(path):
     try:
@@ -267,6 +284,8 @@ def run(name, what):
         "seconds": float(time_lines[-1]) if time_lines else None,
         "verdict": verdict,
         "reasons": "; ".join(reasons or []),
+        "nees": evaluation.get("mean_position_nees"),
+        "coverage": evaluation.get("position_coverage_95"),
     }
 
 def exact(name):
@@ -313,6 +332,14 @@ header = ["dataset", "split", "kind", "DR APE [m]", "RFF APE [m]",
           "WNOA APE [m]", "exact-GP APE [m]", "RFF lm RMS [m]",
           "WNOA lm RMS [m]", "RFF time [s]", "WNOA time [s]", "RFF quality",
           "WNOA quality"]
+if consistency:
+    header += ["RFF NEES / 95%", "WNOA NEES / 95%"]
+
+def consistency_cell(x):
+    if x is None or x["rc"] != 0 or x["nees"] is None:
+        return "-"
+    return f"{x['nees']:.2f} / {x['coverage']:.3f}"
+
 lines = ["| " + " | ".join(header) + " |",
          "| " + " | ".join("---" for _ in header) + " |"]
 for r in rows:
@@ -325,6 +352,8 @@ for r in rows:
              plain(r["rff"], "landmarks", ".3f"),
              plain(r["wnoa"], "landmarks", ".3f"), time_cell(r["rff"]),
              time_cell(r["wnoa"]), verdict(r["rff"]), verdict(r["wnoa"])]
+    if consistency:
+        cells += [consistency_cell(r["rff"]), consistency_cell(r["wnoa"])]
     lines.append("| " + " | ".join(cells) + " |")
 
 def plural(n):
@@ -360,6 +389,19 @@ for split in ("tune", "score"):
             "APE ratio RFF/exact GP (GP draws)",
             [(r["rff"]["ape"], r["exact"]["ape"]) for r in good],
             len(draws) - len(good)))
+    if consistency:
+        for prior in ("rff", "wnoa"):
+            scored = [r[prior] for r in mine
+                      if r[prior] is not None and r[prior]["nees"] is not None]
+            inside = [x for x in scored
+                      if NEES_BAND[0] <= x["nees"] <= NEES_BAND[1] and
+                      COVERAGE_BAND[0] <= x["coverage"] <= COVERAGE_BAND[1]]
+            median = (f"median NEES {statistics.median(x['nees'] for x in scored):.2f}, "
+                      if scored else "")
+            summary.append(
+                f"- {prior.upper()} consistency: {median}{len(inside)} of "
+                f"{len(scored)} with NEES in [{NEES_BAND[0]}, {NEES_BAND[1]}] "
+                f"and 95% coverage in [{COVERAGE_BAND[0]}, {COVERAGE_BAND[1]}]")
     summary.append("")
 
 commit = subprocess.run(["git", "-C", root, "describe", "--always", "--dirty"],
@@ -379,7 +421,9 @@ with open(os.path.join(out, "heldout.csv"), "w", newline="") as f:
                 "wnoa_ape_m", "exact_gp_ape_m", "rff_landmark_rms_m",
                 "wnoa_landmark_rms_m", "rff_seconds", "wnoa_seconds",
                 "rff_rc", "wnoa_rc", "exact_gp_rc", "rff_verdict",
-                "wnoa_verdict", "rff_quality_reasons", "wnoa_quality_reasons"])
+                "wnoa_verdict", "rff_quality_reasons", "wnoa_quality_reasons",
+                "rff_position_nees", "rff_coverage_95", "wnoa_position_nees",
+                "wnoa_coverage_95"])
     get = lambda x, k: "" if x is None or x.get(k) is None else x[k]
     for r in rows:
         w.writerow([r["name"], r["split"], r["kind"], get(r["dr"], "ape"),
@@ -389,5 +433,7 @@ with open(os.path.join(out, "heldout.csv"), "w", newline="") as f:
                     get(r["wnoa"], "seconds"), get(r["rff"], "rc"),
                     get(r["wnoa"], "rc"), get(r["exact"], "rc"),
                     get(r["rff"], "verdict"), get(r["wnoa"], "verdict"),
-                    get(r["rff"], "reasons"), get(r["wnoa"], "reasons")])
+                    get(r["rff"], "reasons"), get(r["wnoa"], "reasons"),
+                    get(r["rff"], "nees"), get(r["rff"], "coverage"),
+                    get(r["wnoa"], "nees"), get(r["wnoa"], "coverage")])
 EOF
