@@ -15,6 +15,7 @@
 #include "rff_ceres/io/dataset_io.h"
 #include "rff_ceres/io/output_file.h"
 #include "rff_ceres/io/text_parser.h"
+#include "rff_ceres/option_error.h"
 #include "tool_flags.h"
 
 DEFINE_string(format, "", "Raw layout of --input: plaza or mrclam");
@@ -118,8 +119,9 @@ bool ConvertPlaza(rff::Dataset* dataset, std::string* error) {
   if (FLAGS_plaza_heading_offset != "auto") {
     double offset;
     if (!rff::ParseFiniteDouble(FLAGS_plaza_heading_offset, &offset)) {
-      *error = "--plaza_heading_offset must be auto or a number [rad], got '" +
-               FLAGS_plaza_heading_offset + "'";
+      *error =
+          rff::OptionError("plaza_heading_offset", FLAGS_plaza_heading_offset,
+                           "", "auto or a finite number [rad]");
       return false;
     }
     options.heading_offset = offset;
@@ -219,7 +221,8 @@ int main(int argc, char** argv) {
   } else if (FLAGS_format == "mrclam") {
     ok = ConvertMrclam(&dataset, &error);
   } else {
-    return Fail("--format must be plaza or mrclam, got '" + FLAGS_format + "'");
+    return Fail(rff::OptionError("format", FLAGS_format, "unknown format",
+                                 "plaza or mrclam"));
   }
   if (!ok) return Fail(error);
   if (!rff::WriteDataset(dataset, FLAGS_output, &error)) return Fail(error);

@@ -13,10 +13,12 @@
 #include <cstdint>
 #include <cstdio>
 #include <string>
+#include <utility>
 
 #include "rff_ceres/io/dataset_io.h"
 #include "rff_ceres/io/output_file.h"
 #include "rff_ceres/io/text_parser.h"
+#include "rff_ceres/option_error.h"
 #include "rff_ceres/simulate.h"
 #include "rff_ceres/simulate_gp_draw.h"
 #include "rff_ceres/types.h"
@@ -111,8 +113,8 @@ int main(int argc, char** argv) {
   } else if (FLAGS_preset == "gp_draw") {
     options = rff::GpDrawOptions(FLAGS_seed);
   } else {
-    return Fail("unknown --preset '" + FLAGS_preset +
-                "' (expected paper, kitti_scale, laser_10hz or gp_draw)");
+    return Fail(rff::OptionError("preset", FLAGS_preset, "unknown preset",
+                                 "paper, kitti_scale, laser_10hz or gp_draw"));
   }
   // With the paper preset every flag applies (its defaults are the paper's);
   // with another preset only the flags given on the command line do.
@@ -124,7 +126,7 @@ int main(int argc, char** argv) {
   if (all || Given("landmarks")) options.num_landmarks = FLAGS_landmarks;
   if (all || Given("kind")) {
     if (!rff::ParseMeasurementKind(FLAGS_kind, &options.kind, &error)) {
-      return Fail("--kind: " + error);
+      return Fail(error);
     }
   }
   if (all || Given("sigma_range")) options.sigma_range = FLAGS_sigma_range;
@@ -133,8 +135,9 @@ int main(int argc, char** argv) {
     constexpr double kMaxSigmaBearingDeg = 360.0;
     if (!(FLAGS_sigma_bearing_deg > 0.0 &&
           FLAGS_sigma_bearing_deg <= kMaxSigmaBearingDeg)) {
-      return Fail("--sigma_bearing_deg must be in (0, 360], got " +
-                  rff::FormatNumber(FLAGS_sigma_bearing_deg));
+      return Fail(rff::OptionError(
+          "sigma_bearing_deg", rff::FormatNumber(FLAGS_sigma_bearing_deg), "",
+          "more than 0 up to " + rff::FormatNumber(kMaxSigmaBearingDeg)));
     }
     options.sigma_bearing = FLAGS_sigma_bearing_deg * kDegree;
   }
@@ -158,8 +161,9 @@ int main(int argc, char** argv) {
   if (all || Given("min_range")) options.min_range = FLAGS_min_range;
   if (all || Given("field_of_view_deg")) {
     if (!(FLAGS_field_of_view_deg > 0.0 && FLAGS_field_of_view_deg <= 360.0)) {
-      return Fail("--field_of_view_deg must be in (0, 360], got " +
-                  rff::FormatNumber(FLAGS_field_of_view_deg));
+      return Fail(rff::OptionError("field_of_view_deg",
+                                   rff::FormatNumber(FLAGS_field_of_view_deg),
+                                   "", "more than 0 up to 360"));
     }
     // 360 degrees must map to exactly 2 pi, the "all around" value.
     options.field_of_view = FLAGS_field_of_view_deg == 360.0
@@ -174,12 +178,18 @@ int main(int argc, char** argv) {
     options.observe_nearest = FLAGS_observe_nearest;
   }
   // The GP's kernel is used by gp_draw only; the options check its values.
-  for (const char* flag :
-       {"gp_kernel", "gp_lengthscale", "gp_kernel_variance",
-        "gp_heading_lengthscale", "gp_heading_kernel_variance"}) {
+  const std::pair<const char*, std::string> gp_flags[] = {
+      {"gp_kernel", FLAGS_gp_kernel},
+      {"gp_lengthscale", rff::FormatNumber(FLAGS_gp_lengthscale)},
+      {"gp_kernel_variance", rff::FormatNumber(FLAGS_gp_kernel_variance)},
+      {"gp_heading_lengthscale",
+       rff::FormatNumber(FLAGS_gp_heading_lengthscale)},
+      {"gp_heading_kernel_variance",
+       rff::FormatNumber(FLAGS_gp_heading_kernel_variance)}};
+  for (const auto& [flag, value] : gp_flags) {
     if (Given(flag) && FLAGS_preset != "gp_draw") {
-      return Fail(std::string("--") + flag +
-                  " applies to --preset=gp_draw only");
+      return Fail(
+          rff::OptionError(flag, value, "applies to --preset=gp_draw only"));
     }
   }
   if (Given("gp_kernel")) options.gp_kernel = FLAGS_gp_kernel;

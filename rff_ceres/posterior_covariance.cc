@@ -10,6 +10,7 @@
 #include "ceres/covariance.h"
 #include "rff_ceres/gauss_newton_system.h"
 #include "rff_ceres/io/text_parser.h"
+#include "rff_ceres/option_error.h"
 #include "rff_ceres/variance_components.h"
 
 namespace rff {
@@ -164,7 +165,8 @@ bool ComputePosteriorCovariance(SlamProblem* problem,
   pose_covariances->clear();
   if (used_schur != nullptr) *used_schur = false;
   if (options.num_threads < 1) {
-    *error = "posterior covariance: num_threads must be >= 1";
+    *error = OptionError("num_threads", std::to_string(options.num_threads), "",
+                         "1 or more");
     return false;
   }
   ceres::Problem* ceres_problem = problem->problem();
