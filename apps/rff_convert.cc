@@ -54,7 +54,8 @@ DEFINE_double(plaza_heading_offset_tolerance, 0.1,
 DEFINE_int32(mrclam_robot, 0, "Robot number 1..5");
 DEFINE_double(mrclam_odometry_interval, 0.0,
               "Longest ODOM step between measurement times [s]; 0: poses "
-              "only at measurement times");
+              "only at measurement times; else at least 0.01, and at most "
+              "1e7 poses in all");
 DEFINE_double(mrclam_range_sigma, 0.1, "RANGE_BEARING range sigma [m]");
 DEFINE_double(mrclam_bearing_sigma, 0.02, "RANGE_BEARING bearing sigma [rad]");
 DEFINE_double(mrclam_odom_sigma_xy_floor, 0.005, "ODOM x/y sigma floor [m]");
