@@ -15,6 +15,7 @@
 #include "rff_ceres/io/dataset_io.h"
 #include "rff_ceres/io/output_file.h"
 #include "rff_ceres/io/text_parser.h"
+#include "rff_ceres/option_error.h"
 #include "tool_flags.h"
 
 DEFINE_string(format, "", "Raw layout of --input: plaza or mrclam");
@@ -53,7 +54,8 @@ DEFINE_double(plaza_heading_offset_tolerance, 0.1,
 DEFINE_int32(mrclam_robot, 0, "Robot number 1..5");
 DEFINE_double(mrclam_odometry_interval, 0.0,
               "Longest ODOM step between measurement times [s]; 0: poses "
-              "only at measurement times");
+              "only at measurement times; else at least 0.01, and at most "
+              "1e7 poses in all");
 DEFINE_double(mrclam_range_sigma, 0.1, "RANGE_BEARING range sigma [m]");
 DEFINE_double(mrclam_bearing_sigma, 0.02, "RANGE_BEARING bearing sigma [rad]");
 DEFINE_double(mrclam_odom_sigma_xy_floor, 0.005, "ODOM x/y sigma floor [m]");
@@ -118,8 +120,9 @@ bool ConvertPlaza(rff::Dataset* dataset, std::string* error) {
   if (FLAGS_plaza_heading_offset != "auto") {
     double offset;
     if (!rff::ParseFiniteDouble(FLAGS_plaza_heading_offset, &offset)) {
-      *error = "--plaza_heading_offset must be auto or a number [rad], got '" +
-               FLAGS_plaza_heading_offset + "'";
+      *error =
+          rff::OptionError("plaza_heading_offset", FLAGS_plaza_heading_offset,
+                           "", "auto or a finite number [rad]");
       return false;
     }
     options.heading_offset = offset;
@@ -219,7 +222,8 @@ int main(int argc, char** argv) {
   } else if (FLAGS_format == "mrclam") {
     ok = ConvertMrclam(&dataset, &error);
   } else {
-    return Fail("--format must be plaza or mrclam, got '" + FLAGS_format + "'");
+    return Fail(rff::OptionError("format", FLAGS_format, "unknown format",
+                                 "plaza or mrclam"));
   }
   if (!ok) return Fail(error);
   if (!rff::WriteDataset(dataset, FLAGS_output, &error)) return Fail(error);

@@ -130,7 +130,7 @@ int main(int argc, char** argv) {
 
   rff::ExperimentConfig config;
   if (!rff::ParseMethods(FLAGS_methods, &config.methods, &error)) {
-    return Fail("--methods: " + error);
+    return Fail(error);
   }
   config.out_dir = FLAGS_out_dir;
   config.quick = FLAGS_quick;

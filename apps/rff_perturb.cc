@@ -21,12 +21,14 @@ DEFINE_string(output, "", "Output .rffd path (required; not the input file).");
 DEFINE_double(landmark_prior_offset, 0.0,
               "Sigma (m) of the N(0, sigma^2) offset added to each axis of "
               "every PRIOR_LANDMARK mean; their sigmas become at least this. "
-              "0 leaves them unchanged.");
+              "0 leaves them unchanged. 0 to 1e6.");
 DEFINE_double(start_heading_offset_deg, 0.0,
-              "Rotation (degrees) of the earliest PRIOR_POSE's heading.");
+              "Rotation (degrees) of the earliest PRIOR_POSE's heading, -360 "
+              "to 360.");
 DEFINE_double(start_heading_sigma, 0.0,
               "New sigma_theta (rad) of the earliest PRIOR_POSE; unchanged "
-              "unless given (pi: the start heading is unknown).");
+              "unless given (pi: the start heading is unknown). More than 0 "
+              "up to 1e6.");
 DEFINE_uint64(seed, 1, "Random seed; the same seed gives the same file.");
 
 namespace {

@@ -13,10 +13,12 @@
 #include <cstdint>
 #include <cstdio>
 #include <string>
+#include <utility>
 
 #include "rff_ceres/io/dataset_io.h"
 #include "rff_ceres/io/output_file.h"
 #include "rff_ceres/io/text_parser.h"
+#include "rff_ceres/option_error.h"
 #include "rff_ceres/simulate.h"
 #include "rff_ceres/simulate_gp_draw.h"
 #include "rff_ceres/types.h"
@@ -30,20 +32,26 @@ DEFINE_string(preset, "paper",
               "degree, 20 m view, odometry) or gp_draw (x, y, theta drawn "
               "from GPs, 600 poses, no odometry, 4 nearest of 25 landmarks). "
               "Flags given explicitly override the preset; the defaults "
-              "below are the paper's.");
+              "below are the paper's. Lengths, times, speeds and sigmas are "
+              "at most 1e6.");
 DEFINE_uint64(seed, 1, "Random seed; the same seed gives the same file.");
-DEFINE_int32(num_steps, 300, "Number of poses (kitti_scale: 3000).");
+DEFINE_int32(num_steps, 300,
+             "Number of poses (kitti_scale: 3000), 1 to 10000000 (gp_draw: "
+             "at most 5000).");
 DEFINE_double(dt, 1.0, "Time step in s (kitti_scale: 0.1).");
 DEFINE_double(speed, 1.0, "Mean forward speed in m/s (kitti_scale: 10).");
-DEFINE_int32(landmarks, 50, "Number of landmarks (kitti_scale: 4000).");
+DEFINE_int32(landmarks, 50,
+             "Number of landmarks (kitti_scale: 4000), 1 to 10000000.");
 DEFINE_string(kind, "range_bearing",
               "Measurement: range, bearing or range_bearing (kitti_scale: "
               "bearing).");
 DEFINE_double(sigma_range, 1.0, "Range noise sigma in m.");
 DEFINE_double(sigma_bearing_deg, 2.0,
-              "Bearing noise sigma in degrees (kitti_scale: 1).");
+              "Bearing noise sigma in degrees (kitti_scale: 1), more than 0 "
+              "up to 360.");
 DEFINE_int32(observations_per_step, 4,
-             "Landmarks observed per pose (kitti_scale: up to 15 visible).");
+             "Landmarks observed per pose (kitti_scale: up to 15 visible), "
+             "1 or more; with --num_steps at most 20000000 observations.");
 DEFINE_bool(odometry, true, "Write ODOM records between consecutive poses.");
 DEFINE_double(odometry_sigma_xy, 0.05, "Odometry translation sigma in m.");
 DEFINE_double(odometry_sigma_theta, 0.01, "Odometry rotation sigma in rad.");
@@ -57,9 +65,11 @@ DEFINE_double(sensor_range, 0.0,
               "(kitti_scale: 40).");
 DEFINE_double(min_range, 2.0, "Closest visible distance in m.");
 DEFINE_double(field_of_view_deg, 360.0,
-              "Field of view in degrees (kitti_scale: 90).");
+              "Field of view in degrees (kitti_scale: 90), more than 0 up "
+              "to 360.");
 DEFINE_int32(min_visible_landmarks, 0,
-             "Least number of landmarks every pose sees (kitti_scale: 10).");
+             "Least number of landmarks every pose sees (kitti_scale: 10), "
+             "0 to 10000.");
 DEFINE_bool(noise_free, false,
             "Add no noise (the sigmas are still written as given).");
 DEFINE_bool(observe_nearest, false,
@@ -68,7 +78,9 @@ DEFINE_bool(observe_nearest, false,
 DEFINE_string(gp_kernel, "matern52",
               "gp_draw: kernel of x, y and theta (rbf, matern12, matern32, "
               "matern52, ...).");
-DEFINE_double(gp_lengthscale, 8.0, "gp_draw: lengthscale of x and y in s.");
+DEFINE_double(gp_lengthscale, 8.0,
+              "gp_draw: lengthscale of x and y in s, more than 0 up to 1e6 "
+              "(and the other gp_ scales).");
 DEFINE_double(gp_kernel_variance, 25.0,
               "gp_draw: kernel variance of x and y in m^2.");
 DEFINE_double(gp_heading_lengthscale, 12.0,
@@ -111,8 +123,8 @@ int main(int argc, char** argv) {
   } else if (FLAGS_preset == "gp_draw") {
     options = rff::GpDrawOptions(FLAGS_seed);
   } else {
-    return Fail("unknown --preset '" + FLAGS_preset +
-                "' (expected paper, kitti_scale, laser_10hz or gp_draw)");
+    return Fail(rff::OptionError("preset", FLAGS_preset, "unknown preset",
+                                 "paper, kitti_scale, laser_10hz or gp_draw"));
   }
   // With the paper preset every flag applies (its defaults are the paper's);
   // with another preset only the flags given on the command line do.
@@ -124,7 +136,7 @@ int main(int argc, char** argv) {
   if (all || Given("landmarks")) options.num_landmarks = FLAGS_landmarks;
   if (all || Given("kind")) {
     if (!rff::ParseMeasurementKind(FLAGS_kind, &options.kind, &error)) {
-      return Fail("--kind: " + error);
+      return Fail(error);
     }
   }
   if (all || Given("sigma_range")) options.sigma_range = FLAGS_sigma_range;
@@ -133,8 +145,9 @@ int main(int argc, char** argv) {
     constexpr double kMaxSigmaBearingDeg = 360.0;
     if (!(FLAGS_sigma_bearing_deg > 0.0 &&
           FLAGS_sigma_bearing_deg <= kMaxSigmaBearingDeg)) {
-      return Fail("--sigma_bearing_deg must be in (0, 360], got " +
-                  rff::FormatNumber(FLAGS_sigma_bearing_deg));
+      return Fail(rff::OptionError(
+          "sigma_bearing_deg", rff::FormatNumber(FLAGS_sigma_bearing_deg), "",
+          "more than 0 up to " + rff::FormatNumber(kMaxSigmaBearingDeg)));
     }
     options.sigma_bearing = FLAGS_sigma_bearing_deg * kDegree;
   }
@@ -158,8 +171,9 @@ int main(int argc, char** argv) {
   if (all || Given("min_range")) options.min_range = FLAGS_min_range;
   if (all || Given("field_of_view_deg")) {
     if (!(FLAGS_field_of_view_deg > 0.0 && FLAGS_field_of_view_deg <= 360.0)) {
-      return Fail("--field_of_view_deg must be in (0, 360], got " +
-                  rff::FormatNumber(FLAGS_field_of_view_deg));
+      return Fail(rff::OptionError("field_of_view_deg",
+                                   rff::FormatNumber(FLAGS_field_of_view_deg),
+                                   "", "more than 0 up to 360"));
     }
     // 360 degrees must map to exactly 2 pi, the "all around" value.
     options.field_of_view = FLAGS_field_of_view_deg == 360.0
@@ -174,12 +188,18 @@ int main(int argc, char** argv) {
     options.observe_nearest = FLAGS_observe_nearest;
   }
   // The GP's kernel is used by gp_draw only; the options check its values.
-  for (const char* flag :
-       {"gp_kernel", "gp_lengthscale", "gp_kernel_variance",
-        "gp_heading_lengthscale", "gp_heading_kernel_variance"}) {
+  const std::pair<const char*, std::string> gp_flags[] = {
+      {"gp_kernel", FLAGS_gp_kernel},
+      {"gp_lengthscale", rff::FormatNumber(FLAGS_gp_lengthscale)},
+      {"gp_kernel_variance", rff::FormatNumber(FLAGS_gp_kernel_variance)},
+      {"gp_heading_lengthscale",
+       rff::FormatNumber(FLAGS_gp_heading_lengthscale)},
+      {"gp_heading_kernel_variance",
+       rff::FormatNumber(FLAGS_gp_heading_kernel_variance)}};
+  for (const auto& [flag, value] : gp_flags) {
     if (Given(flag) && FLAGS_preset != "gp_draw") {
-      return Fail(std::string("--") + flag +
-                  " applies to --preset=gp_draw only");
+      return Fail(
+          rff::OptionError(flag, value, "applies to --preset=gp_draw only"));
     }
   }
   if (Given("gp_kernel")) options.gp_kernel = FLAGS_gp_kernel;

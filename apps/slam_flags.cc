@@ -32,24 +32,32 @@ DEFINE_string(kernel, "rbf",
               "Kernel of x and y: rbf, matern12, matern32, matern52, "
               "periodic.");
 DEFINE_string(heading_kernel, "", "Kernel of theta (default: --kernel).");
-DEFINE_double(lengthscale, 10.0, "Kernel lengthscale of x and y (seconds).");
+DEFINE_double(lengthscale, 10.0,
+              "Kernel lengthscale of x and y (seconds), more than 0 up to "
+              "1e12 (periodic: at least 0.001).");
 DEFINE_double(heading_lengthscale, 0.0,
-              "Kernel lengthscale of theta (0: --lengthscale).");
+              "Kernel lengthscale of theta (0: --lengthscale); limits as "
+              "--lengthscale.");
 DEFINE_double(kernel_variance, 4.0,
               "Kernel variance of x and y (m^2): the prior spread of the "
-              "trajectory around its mean.");
+              "trajectory around its mean. More than 0 up to 1e24.");
 DEFINE_double(heading_kernel_variance, 0.1,
-              "Kernel variance of theta (rad^2).");
-DEFINE_double(period, 1.0, "Period of the periodic kernel (seconds).");
+              "Kernel variance of theta (rad^2), more than 0 up to 1e24.");
+DEFINE_double(period, 1.0,
+              "Period of the periodic kernel (seconds), more than 0 up to "
+              "1e12.");
 DEFINE_string(features, "hilbert",
               "Feature family: rff, qmc, gauss_hermite, hilbert.");
 DEFINE_int32(num_features, 0,
              "Features per coordinate of x and y (D) per segment; 0 (auto): "
              "D, the segment length and the overlap follow the lengthscales "
              "so that the motion the basis misses stays below 5 cm and "
-             "0.005 rad. At most 1024.");
+             "0.005 rad. At most 1024; even for rff, qmc and gauss_hermite, "
+             "odd for the periodic kernel. Segments x (2 D^2 + D_theta^2) "
+             "is at most 2e8 (the prior's memory).");
 DEFINE_int32(num_heading_features, 0,
-             "Features of theta (0: --num_features). At most 1024.");
+             "Features of theta (0: --num_features). At most 1024; needs "
+             "--num_features > 0.");
 DEFINE_string(learn_hyperparameters, "auto",
               "Learn the prior's hyperparameters from the data: on, off or "
               "auto. RFF: lengthscales and variances of x, y and theta by the "
@@ -65,7 +73,8 @@ DEFINE_double(segment_length, 0.0,
               "Windowed weights: segment length in seconds (0: one global "
               "feature map over the whole run). At most 100000 segments.");
 DEFINE_double(segment_overlap, 0.0,
-              "Windowed weights: blend overlap between segments (seconds).");
+              "Windowed weights: blend overlap between segments (seconds), "
+              "less than --segment_length.");
 
 // WNOA (LTV-SDE) prior.
 DEFINE_double(wnoa_position_qc, 1.0,
@@ -90,26 +99,28 @@ DEFINE_double(wnoa_min_state_spacing, 0.0,
 // Incremental mode.
 DEFINE_int32(incremental_every, 0,
              "Incremental mode: feed measurements in time order and re-solve "
-             "after every K new range/bearing measurements (0: batch).");
+             "after every K new range/bearing measurements (0: batch). 0 or "
+             "more.");
 DEFINE_double(incremental_lag, 0.0,
               "Incremental mode: freeze trajectory blocks untouched for this "
               "many seconds (0: never freeze).");
 
 DEFINE_int32(outer_rounds, 0,
              "Smoothing-spline prior rounds (paper III-B.2): refit the mean "
-             "to the estimate and re-solve this many times (at most 100).");
+             "to the estimate and re-solve this many times (at most 100; "
+             "0 in incremental mode).");
 DEFINE_double(spline_smoothing, 0.98,
-              "Smoothing parameter p of the spline mean (De Boor).");
+              "Smoothing parameter p of the spline mean (De Boor), 0 to 1.");
 
 // Problem.
 DEFINE_string(loss, "auto",
               "Robust loss on observations: none, huber, cauchy, auto (cauchy, "
               "then none where no residual is an outlier).");
-DEFINE_double(loss_scale, 2.0, "Robust loss scale, in sigmas.");
+DEFINE_double(loss_scale, 2.0, "Robust loss scale, in sigmas (more than 0).");
 DEFINE_string(odometry_loss, "auto",
               "Robust loss on odometry residuals: none, huber, cauchy, auto.");
 DEFINE_double(odometry_loss_scale, 2.0,
-              "Robust odometry loss scale, in sigmas.");
+              "Robust odometry loss scale, in sigmas (more than 0).");
 DEFINE_bool(estimate_range_calibration, false,
             "Estimate a range sensor model scale * distance + offset jointly "
             "(one per run) for the ranges of RANGE and RANGE_BEARING records, "
@@ -133,9 +144,10 @@ DEFINE_double(max_preintegration_seconds, 1.0,
 
 // Ceres.
 DEFINE_double(max_memory_gb, 0.0,
-              "Largest linear system a solve may form, in GB (0: half of the "
-              "machine's memory); a dense solver whose system is larger is "
-              "refused before the solve, naming the size.");
+              "Largest linear system a solve may form, in GB, 0 or more (0: "
+              "half of the machine's memory or of the address-space limit); "
+              "a solver whose system is larger is refused before the solve, "
+              "naming the size.");
 DEFINE_string(linear_solver, "auto",
               "Ceres linear solver: auto (DENSE_SCHUR when at most 2000 "
               "trajectory parameters remain after eliminating the landmarks, "
@@ -150,8 +162,10 @@ DEFINE_string(trust_region_strategy, "LEVENBERG_MARQUARDT",
 DEFINE_int32(num_threads, 1,
              "Threads for Jacobians and linear algebra. With 1 the outputs "
              "are byte-identical from run to run; with more, Ceres sums in "
-             "thread-scheduling order and results differ in the last bits.");
-DEFINE_int32(max_iterations, 100, "Maximum number of solver iterations.");
+             "thread-scheduling order and results differ in the last bits. "
+             "1 or more.");
+DEFINE_int32(max_iterations, 100,
+             "Maximum number of solver iterations (1 or more).");
 DEFINE_double(function_tolerance, 1e-8, "Ceres function tolerance.");
 DEFINE_double(gradient_tolerance, 1e-10, "Ceres gradient tolerance.");
 DEFINE_double(parameter_tolerance, 1e-8, "Ceres parameter tolerance.");

@@ -8,6 +8,7 @@
 #include "costs/weight_prior_cost.h"
 #include "rff_ceres/features/hilbert_features.h"
 #include "rff_ceres/io/text_parser.h"
+#include "rff_ceres/option_error.h"
 
 namespace rff {
 
@@ -82,42 +83,52 @@ std::unique_ptr<FeatureTrajectory> FeatureTrajectory::Create(
        {std::pair(requested.num_position_features, "num_features"),
         std::pair(requested.num_heading_features, "num_heading_features")}) {
     if (d < 0 || d > kMaxFeatures) {
-      *error = std::string(name) + " must be in [0, " +
-               std::to_string(kMaxFeatures) +
-               "] (0: from the capacity rule), got " + std::to_string(d);
+      *error = OptionError(
+          name, std::to_string(d), "",
+          "0 (from the capacity rule) to " + std::to_string(kMaxFeatures));
       return nullptr;
     }
   }
   if (requested.num_position_features == kAutoCapacity &&
       requested.num_heading_features != kAutoCapacity) {
-    *error = "num_heading_features " +
-             std::to_string(requested.num_heading_features) +
-             " needs num_features > 0 (num_features 0 derives both from the "
-             "capacity rule)";
+    *error = OptionError(
+        "num_heading_features", std::to_string(requested.num_heading_features),
+        "--num_features=0 derives both counts from the capacity rule",
+        "0 there, or give --num_features too");
     return nullptr;
   }
   if (!(requested.segment_length >= 0.0) ||
-      !(requested.segment_overlap >= 0.0) ||
-      !std::isfinite(requested.segment_length) ||
+      !std::isfinite(requested.segment_length)) {
+    *error =
+        OptionError("segment_length", FormatNumber(requested.segment_length),
+                    "", "0 (one global map) or more");
+    return nullptr;
+  }
+  if (!(requested.segment_overlap >= 0.0) ||
       (requested.segment_length > 0.0 &&
        !(requested.segment_overlap < requested.segment_length))) {
-    *error = "segment length and overlap must be >= 0, with overlap < length";
+    *error = OptionError("segment_overlap",
+                         FormatNumber(requested.segment_overlap), "",
+                         "0 or more, less than --segment_length=" +
+                             FormatNumber(requested.segment_length));
     return nullptr;
   }
   if (requested.segment_length == 0.0 && requested.segment_overlap != 0.0) {
-    *error = "segment_overlap " + FormatNumber(requested.segment_overlap) +
-             " needs a segment_length (0: one global map, or the capacity "
-             "rule's segments)";
+    *error = OptionError(
+        "segment_overlap", FormatNumber(requested.segment_overlap),
+        "blends segments, but --segment_length=0 has none", "0 there");
     return nullptr;
   }
   // A run with one time still needs a window of positive length.
   const double length = std::max(t_end - t_begin, 1e-3);
   if (requested.segment_length > 0.0 &&
       !(length / requested.segment_length <= kMaxSegments)) {
-    *error = "segment_length " + FormatNumber(requested.segment_length) +
-             " s cuts the run's " + FormatNumber(length) +
-             " s into more than " + std::to_string(kMaxSegments) +
-             " segments; give a longer one";
+    *error = OptionError(
+        "segment_length", FormatNumber(requested.segment_length),
+        "cuts the run's " + FormatNumber(length) + " s into more than " +
+            std::to_string(kMaxSegments) + " segments",
+        "0 or at least " + FormatNumber(length / kMaxSegments) +
+            " for this run");
     return nullptr;
   }
   const FeatureTrajectoryOptions options = AutoCapacity(requested, length);
@@ -125,12 +136,30 @@ std::unique_ptr<FeatureTrajectory> FeatureTrajectory::Create(
       SegmentCount(options.segment_length, length);
   const double dp = options.num_position_features;
   const double dh = options.num_heading_features;
-  if (num_segments_needed * (2.0 * dp * dp + dh * dh) > kMaxPriorNonZeros) {
-    *error = "the run's " + FormatNumber(length) + " s need " +
-             FormatNumber(num_segments_needed) + " segments of " +
-             FormatNumber(dp) + " features (x, y) and " + FormatNumber(dh) +
-             " (theta): more weights than memory allows; give fewer "
-             "features or longer segments";
+  const double weights_per_segment = 2.0 * dp * dp + dh * dh;
+  if (num_segments_needed * weights_per_segment > kMaxPriorNonZeros) {
+    const std::string why = "the run's " + FormatNumber(length) + " s need " +
+                            FormatNumber(num_segments_needed) +
+                            " segments of " + FormatNumber(dp) +
+                            " features (x, y) and " + FormatNumber(dh) +
+                            " (theta): more weights than memory allows";
+    // Fewer segments of these features, or as many of fewer features.
+    const double shortest_segment =
+        length / std::floor(kMaxPriorNonZeros / weights_per_segment);
+    if (requested.num_position_features == kAutoCapacity) {
+      *error = OptionError(
+          "segment_length", FormatNumber(requested.segment_length), why,
+          "at least " + FormatNumber(shortest_segment) + " for this run");
+    } else {
+      const double most_features = std::floor(
+          std::sqrt(kMaxPriorNonZeros / (3.0 * num_segments_needed)));
+      *error = OptionError(
+          "num_features", std::to_string(requested.num_position_features), why,
+          "at most " + FormatNumber(most_features) +
+              " (as many for theta) for this run, or --segment_length of at "
+              "least " +
+              FormatNumber(shortest_segment));
+    }
     return nullptr;
   }
   std::unique_ptr<FeatureTrajectory> model(new FeatureTrajectory);
@@ -139,7 +168,8 @@ std::unique_ptr<FeatureTrajectory> FeatureTrajectory::Create(
   model->origin_ = t_begin;
   model->position_kernel_ = CreateKernel(options.position_kernel, error);
   if (!model->position_kernel_) return nullptr;
-  model->heading_kernel_ = CreateKernel(options.heading_kernel, error);
+  model->heading_kernel_ =
+      CreateKernel(options.heading_kernel, error, "heading_");
   if (!model->heading_kernel_) return nullptr;
 
   // Bounded above by the prior's size check.
@@ -152,6 +182,7 @@ std::unique_ptr<FeatureTrajectory> FeatureTrajectory::Create(
     s.end = (k + 1) * segment;
     FeatureMapOptions map_options;
     map_options.family = options.family;
+    map_options.num_features_flag = "num_features";
     // Each segment's maps cover its extent and half the overlap each side.
     map_options.window_begin = k > 0 ? -0.5 * model->overlap_ : 0.0;
     map_options.window_end =
@@ -162,6 +193,7 @@ std::unique_ptr<FeatureTrajectory> FeatureTrajectory::Create(
         CreateFeatureMap(*model->position_kernel_, map_options, error);
     if (!s.position_map) return nullptr;
     map_options.num_features = options.num_heading_features;
+    map_options.num_features_flag = "num_heading_features";
     map_options.seed = options.seed + 2 * k + 1;  // Independent draws.
     s.heading_map =
         CreateFeatureMap(*model->heading_kernel_, map_options, error);

@@ -11,6 +11,8 @@
 
 #include "ceres/problem.h"
 #include "ceres/types.h"
+#include "rff_ceres/io/text_parser.h"
+#include "rff_ceres/option_error.h"
 
 namespace rff {
 
@@ -112,31 +114,44 @@ double MemoryLimitBytes(double max_memory_gb) {
 
 bool CheckLinearSystemFits(SlamProblem* problem,
                            const ceres::Solver::Options& options,
-                           double limit_bytes, std::string* error) {
+                           double max_memory_gb, std::string* error) {
+  const double limit_bytes = MemoryLimitBytes(max_memory_gb);
   const LinearSystemSize size =
       EstimateLinearSystemSize(problem, options.linear_solver_type);
   if (size.bytes <= limit_bytes) return true;
   const ceres::LinearSolverType type = options.linear_solver_type;
+  const std::string solver = ceres::LinearSolverTypeToString(type);
   const bool dense = type == ceres::DENSE_QR || type == ceres::DENSE_SCHUR ||
                      type == ceres::DENSE_NORMAL_CHOLESKY;
+  char needs[256];
+  std::snprintf(needs, sizeof(needs),
+                "needs about %.3g GB for its %lld x %lld %s, more than the "
+                "%.3g GB allowed by --max_memory_gb",
+                size.bytes / 1e9, size.rows, size.cols, size.what.c_str(),
+                limit_bytes / 1e9);
   // Eliminating a landmark couples every state that sees it: one landmark
   // seen from the whole run fills the reduced system.
-  const char* way_out =
-      type == ceres::SPARSE_SCHUR
-          ? "eliminating the landmarks couples the states that see a common "
-            "landmark; --linear_solver=auto or SPARSE_NORMAL_CHOLESKY "
-            "factorises the sparse system as it is"
-      : dense ? "--linear_solver=auto picks a sparse factorisation where the "
-                "system is banded"
-              : "give fewer features or longer segments";
-  char buffer[512];
-  std::snprintf(buffer, sizeof(buffer),
-                "linear solver %s needs about %.3g GB for its %lld x %lld %s, "
-                "more than the %.3g GB allowed (--max_memory_gb); %s",
-                ceres::LinearSolverTypeToString(type), size.bytes / 1e9,
-                size.rows, size.cols, size.what.c_str(), limit_bytes / 1e9,
-                way_out);
-  *error = buffer;
+  if (type == ceres::SPARSE_SCHUR) {
+    *error = OptionError("linear_solver", solver,
+                         std::string(needs) +
+                             " (eliminating the landmarks couples the states "
+                             "that see a common landmark)",
+                         "auto or SPARSE_NORMAL_CHOLESKY, which factorise the "
+                         "sparse system as it is");
+  } else if (dense) {
+    *error = OptionError("linear_solver", solver, needs,
+                         "auto, which picks a sparse factorisation where the "
+                         "system is banded");
+  } else {
+    // The sparse system itself is too large: a smaller model or a larger
+    // limit are the ways out.
+    char more[64];
+    std::snprintf(more, sizeof(more), "%.3g", size.bytes / 1e9);
+    *error = OptionError(
+        "max_memory_gb", FormatNumber(max_memory_gb),
+        solver + " " + needs + " (fewer features or longer segments need less)",
+        std::string("more than ") + more + " where the machine has it");
+  }
   return false;
 }
 

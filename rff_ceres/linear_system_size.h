@@ -35,10 +35,11 @@ LinearSystemSize EstimateLinearSystemSize(SlamProblem* problem,
 double MemoryLimitBytes(double max_memory_gb);
 
 // False, with the message a user needs (solver, size, limit and the way
-// out), when the chosen solver's system exceeds `limit_bytes`.
+// out), when the chosen solver's system exceeds MemoryLimitBytes of
+// `max_memory_gb` (--max_memory_gb).
 bool CheckLinearSystemFits(SlamProblem* problem,
                            const ceres::Solver::Options& options,
-                           double limit_bytes, std::string* error);
+                           double max_memory_gb, std::string* error);
 
 }  // namespace rff
 

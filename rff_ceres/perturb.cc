@@ -7,6 +7,7 @@
 #include "rff_ceres/io/dataset_io.h"
 #include "rff_ceres/io/output_file.h"
 #include "rff_ceres/io/text_parser.h"
+#include "rff_ceres/option_error.h"
 #include "rff_ceres/simulate.h"
 
 namespace rff {
@@ -14,12 +15,10 @@ namespace {
 
 constexpr double kDegree = M_PI / 180.0;
 
-// The one message style of the option checks.
-bool InRange(bool in_range, const char* name, double value, const char* range,
-             std::string* error) {
+bool InRange(bool in_range, const char* flag, double value,
+             const std::string& range, std::string* error) {
   if (in_range) return true;
-  *error = std::string(name) + " must be in " + range + ", got " +
-           FormatNumber(value);
+  *error = OptionError(flag, FormatNumber(value), "", range);
   return false;
 }
 
@@ -84,16 +83,18 @@ bool ValidatePerturbOptions(const PerturbOptions& o, std::string* error) {
   // Written as "inside" tests so that NaN fails every one of them.
   const double offset = o.landmark_prior_offset;
   const double heading = o.start_heading_offset_deg;
+  const std::string largest = FormatNumber(kMaxPerturbMagnitude);
   return InRange(offset >= 0.0 && offset <= kMaxPerturbMagnitude,
-                 "landmark_prior_offset", offset, "[0, 1e+06] m", error) &&
+                 "landmark_prior_offset", offset, "0 to " + largest + " m",
+                 error) &&
          InRange(heading >= -360.0 && heading <= 360.0,
-                 "start_heading_offset_deg", heading, "[-360, 360] deg",
+                 "start_heading_offset_deg", heading, "-360 to 360 degrees",
                  error) &&
          (!o.start_heading_sigma ||
           InRange(*o.start_heading_sigma > 0.0 &&
                       *o.start_heading_sigma <= kMaxPerturbMagnitude,
                   "start_heading_sigma", *o.start_heading_sigma,
-                  "(0, 1e+06] rad", error));
+                  "more than 0 up to " + largest + " rad", error));
 }
 
 bool ChangesLandmarkPriors(const PerturbOptions& options) {
@@ -128,8 +129,9 @@ bool PerturbFile(const std::string& input, const std::string& output,
                  const PerturbOptions& options, std::string* error) {
   if (!ValidatePerturbOptions(options, error)) return false;
   if (SameFile(input, output)) {
-    *error = "output " + output + " is the input file " + input +
-             "; write the perturbed dataset elsewhere";
+    *error = OptionError("output", output,
+                         "the same file as the input --input=" + input,
+                         "another path");
     return false;
   }
   Dataset dataset;

@@ -35,8 +35,7 @@ struct PerturbOptions {
 inline constexpr double kMaxPerturbMagnitude = 1e6;
 
 // Checks every option; on failure `error` names the option, its value and
-// the allowed range ("landmark_prior_offset must be in [0, 1e+06] m, got
-// -1").
+// the allowed range ("--landmark_prior_offset=-1: allowed 0 to 1e+06 m").
 bool ValidatePerturbOptions(const PerturbOptions& options, std::string* error);
 
 // Whether the options change the landmark priors or the start heading.

@@ -11,6 +11,7 @@
 #include "ceres/covariance.h"
 #include "rff_ceres/gauss_newton_system.h"
 #include "rff_ceres/io/text_parser.h"
+#include "rff_ceres/option_error.h"
 #include "rff_ceres/selected_inverse.h"
 #include "rff_ceres/variance_components.h"
 
@@ -228,7 +229,8 @@ bool ComputePosteriorCovariance(SlamProblem* problem,
                                 std::string* error, CovarianceMethod* method) {
   pose_covariances->clear();
   if (options.num_threads < 1) {
-    *error = "posterior covariance: num_threads must be >= 1";
+    *error = OptionError("num_threads", std::to_string(options.num_threads), "",
+                         "1 or more");
     return false;
   }
   ceres::Problem* ceres_problem = problem->problem();

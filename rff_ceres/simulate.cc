@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "rff_ceres/io/text_parser.h"
+#include "rff_ceres/option_error.h"
 #include "rff_ceres/se2.h"
 #include "rff_ceres/simulate_gp_draw.h"
 
@@ -70,8 +71,8 @@ bool ParseMeasurementKind(const std::string& name, MeasurementKind* kind,
   } else if (name == "range_bearing" || name == "rb") {
     *kind = MeasurementKind::kRangeBearing;
   } else {
-    *error = "unknown measurement kind '" + name +
-             "' (expected range, bearing or range_bearing)";
+    *error = OptionError("kind", name, "unknown measurement kind",
+                         "range, bearing or range_bearing");
     return false;
   }
   return true;
@@ -182,8 +183,8 @@ class OptionChecker {
   void IntAtLeast(const char* name, int value, int low, int high) {
     if (!ok_) return;
     if (value < low || value > high) {
-      Fail(std::string(name) + " must be in [" + std::to_string(low) + ", " +
-           std::to_string(high) + "], got " + std::to_string(value));
+      Fail(OptionError(name, std::to_string(value), "",
+                       std::to_string(low) + " to " + std::to_string(high)));
     }
   }
   // Finite and in (0, kMaxMagnitude] (positive) or [0, kMaxMagnitude].
@@ -204,9 +205,9 @@ class OptionChecker {
     if (!ok_) return;
     const bool low_ok = allow_zero ? value >= 0.0 : value > 0.0;
     if (!(std::isfinite(value) && low_ok && value <= kMaxMagnitude)) {
-      Fail(std::string(name) + " must be finite and " +
-           (allow_zero ? ">= 0" : "> 0") + " (at most " +
-           FormatNumber(kMaxMagnitude) + "), got " + FormatNumber(value));
+      Fail(OptionError(name, FormatNumber(value), "",
+                       (allow_zero ? "0 to " : "more than 0 up to ") +
+                           FormatNumber(kMaxMagnitude)));
     }
   }
 
@@ -582,28 +583,35 @@ bool ValidateSimulationOptions(const SimulationOptions& o, std::string* error) {
                c == '-';
       });
   if (!preset_is_word) {
-    check.Fail("preset must be one word of letters, digits, '_' or '-', got '" +
-               o.preset + "'");
+    check.Fail(OptionError("preset", o.preset, "",
+                           "one word of up to 64 letters, digits, '_' or '-'"));
   } else if (o.field_of_view > 2.0 * M_PI) {
-    check.Fail("field_of_view must be at most 2 pi, got " +
-               FormatNumber(o.field_of_view));
+    check.Fail(OptionError("field_of_view", FormatNumber(o.field_of_view),
+                           "more than all around", "more than 0 up to 2 pi"));
   } else if (o.sensor_range > 0.0 && o.sensor_range <= o.min_range) {
-    check.Fail("sensor_range must exceed min_range (" +
-               FormatNumber(o.min_range) + "), got " +
-               FormatNumber(o.sensor_range));
+    check.Fail(OptionError(
+        "sensor_range", FormatNumber(o.sensor_range),
+        "sees nothing beyond --min_range=" + FormatNumber(o.min_range),
+        "0 (every landmark visible) or more than " +
+            FormatNumber(o.min_range)));
   } else if (o.sensor_range == 0.0 &&
              o.min_visible_landmarks > o.num_landmarks) {
-    check.Fail("min_visible_landmarks (" +
-               std::to_string(o.min_visible_landmarks) +
-               ") exceeds landmarks (" + std::to_string(o.num_landmarks) +
-               ") and there is no sensor_range to place more");
+    check.Fail(OptionError(
+        "min_visible_landmarks", std::to_string(o.min_visible_landmarks),
+        "more than --landmarks=" + std::to_string(o.num_landmarks) +
+            ", and no --sensor_range to place more",
+        "at most " + std::to_string(o.num_landmarks)));
   } else if (static_cast<std::int64_t>(o.num_steps) *
                  (o.sensor_range > 0.0
                       ? o.observations_per_step
                       : std::min(o.observations_per_step, o.num_landmarks)) >
              kMaxObservations) {
-    check.Fail("num_steps x observations_per_step exceeds " +
-               std::to_string(kMaxObservations) + " observations");
+    check.Fail(OptionError(
+        "observations_per_step", std::to_string(o.observations_per_step),
+        "with --num_steps=" + std::to_string(o.num_steps) + " more than " +
+            std::to_string(kMaxObservations) + " observations",
+        "at most " + std::to_string(kMaxObservations / o.num_steps) +
+            " for these steps"));
   }
   return check.ok();
 }

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "rff_ceres/io/text_parser.h"
+#include "rff_ceres/option_error.h"
 
 namespace rff {
 
@@ -58,11 +59,13 @@ KernelOptions GpDrawHeadingKernel(const SimulationOptions& options) {
 bool ValidateGpDrawOptions(const SimulationOptions& options,
                            std::string* error) {
   if (options.num_steps > kMaxGpDrawSteps) {
-    *error = "num_steps must be at most " + std::to_string(kMaxGpDrawSteps) +
-             " for a GP draw (dense O(N^3) factorisation), got " +
-             std::to_string(options.num_steps);
+    *error = OptionError(
+        "num_steps", std::to_string(options.num_steps),
+        "a GP draw factorises a dense N x N matrix, O(N^3)",
+        "1 to " + std::to_string(kMaxGpDrawSteps) + " with --preset=gp_draw");
     return false;
   }
+  constexpr double kMaxGpScale = 1e6;
   const struct {
     const char* name;
     double value;
@@ -74,19 +77,15 @@ bool ValidateGpDrawOptions(const SimulationOptions& options,
   };
   for (const auto& option : positives) {
     if (!(std::isfinite(option.value) && option.value > 0.0 &&
-          option.value <= 1e6)) {
-      *error = std::string(option.name) +
-               " must be finite and > 0 (at most 1e+06), got " +
-               FormatNumber(option.value);
+          option.value <= kMaxGpScale)) {
+      *error = OptionError(option.name, FormatNumber(option.value), "",
+                           "more than 0 up to " + FormatNumber(kMaxGpScale));
       return false;
     }
   }
-  std::string why;
-  if (!CreateKernel(GpDrawPositionKernel(options), &why)) {
-    *error = "gp_kernel: " + why;
-    return false;
-  }
-  return true;
+  // The heading kernel shares --gp_kernel: its name is checked with x, y.
+  return CreateKernel(GpDrawPositionKernel(options), error, "gp_") &&
+         CreateKernel(GpDrawHeadingKernel(options), error, "gp_heading_");
 }
 
 bool DrawGaussianProcess(const Kernel& kernel, const std::vector<double>& times,

@@ -11,19 +11,19 @@
 #include "rff_ceres/mean/localization_mean.h"
 #include "rff_ceres/mean/mean_function.h"
 #include "rff_ceres/mean/prior_mean.h"
+#include "rff_ceres/option_error.h"
 #include "rff_ceres/slam_solver.h"
 #include "rff_ceres/wnoa_trajectory.h"
 
 namespace rff {
 namespace {
 
-bool CheckOneOf(const std::string& value, const char* name,
+bool CheckOneOf(const std::string& value, const char* flag, const char* what,
                 const std::vector<std::string>& allowed, std::string* error) {
   if (std::find(allowed.begin(), allowed.end(), value) != allowed.end()) {
     return true;
   }
-  *error = std::string(name) + " must be " + JoinAlternatives(allowed) +
-           ", got '" + value + "'";
+  *error = OptionError(flag, value, what, JoinAlternatives(allowed));
   return false;
 }
 
@@ -32,62 +32,61 @@ bool CheckOneOf(const std::string& value, const char* name,
 bool ValidateSlamOptions(const SlamOptions& options, std::string* error) {
   ceres::Solver::Options ceres_options;
   if (!ToCeresOptions(options.solver, &ceres_options, error) ||
-      !CheckOneOf(options.prior, "prior", {"rff", "wnoa"}, error) ||
-      !CheckOneOf(options.prior_mean, "prior_mean", PriorMeanNames(), error) ||
-      !CheckOneOf(options.learn_hyperparameters, "learn_hyperparameters",
+      !CheckOneOf(options.prior, "prior", "unknown prior", {"rff", "wnoa"},
+                  error) ||
+      !CheckOneOf(options.prior_mean, "prior_mean", "unknown prior mean",
+                  PriorMeanNames(), error) ||
+      !CheckOneOf(options.learn_hyperparameters, "learn_hyperparameters", "",
                   {"auto", "on", "off"}, error) ||
-      !CheckOneOf(options.initial_trajectory, "initial_trajectory",
+      !CheckOneOf(options.initial_trajectory, "initial_trajectory", "",
                   {"auto", "mean"}, error)) {
     return false;
   }
   if (options.prior_mean == "wnoa" && options.prior != "rff") {
-    *error = "prior mean 'wnoa' is for the rff prior";
+    *error = OptionError("prior_mean", "wnoa",
+                         "a WNOA-solve mean is for --prior=rff only");
     return false;
   }
-  if (!(options.solver.max_memory_gb >= 0.0) ||
-      !std::isfinite(options.solver.max_memory_gb)) {
-    *error = "max_memory_gb must be finite and >= 0, got " +
-             FormatNumber(options.solver.max_memory_gb);
+  if (!CheckNonNegativeOption(options.solver.max_memory_gb, "max_memory_gb",
+                              error)) {
     return false;
   }
   if (options.outer_rounds < 0 || options.outer_rounds > kMaxOuterRounds) {
-    *error = "outer_rounds must be in [0, " + std::to_string(kMaxOuterRounds) +
-             "], got " + std::to_string(options.outer_rounds);
+    *error = OptionError(
+        "outer_rounds", std::to_string(options.outer_rounds),
+        options.outer_rounds > 0 ? "more spline refits than supported" : "",
+        "0 to " + std::to_string(kMaxOuterRounds));
     return false;
   }
-  if (!(options.problem.max_preintegration_seconds >= 0.0) ||
-      !std::isfinite(options.problem.max_preintegration_seconds)) {
-    *error = "max_preintegration_seconds must be finite and >= 0, got " +
-             FormatNumber(options.problem.max_preintegration_seconds);
+  if (!CheckNonNegativeOption(options.problem.max_preintegration_seconds,
+                              "max_preintegration_seconds", error)) {
     return false;
   }
   if (!(options.spline_smoothing >= 0.0 && options.spline_smoothing <= 1.0)) {
-    *error = "spline_smoothing must be in [0, 1], got " +
-             FormatNumber(options.spline_smoothing);
+    *error = OptionError("spline_smoothing",
+                         FormatNumber(options.spline_smoothing), "", "0 to 1");
     return false;
   }
   const IncrementalOptions& incremental = options.incremental;
   if (incremental.every < 0) {
-    *error = "incremental_every must be >= 0, got " +
-             std::to_string(incremental.every);
+    *error = OptionError("incremental_every", std::to_string(incremental.every),
+                         "", "0 (batch) or more");
     return false;
   }
-  if (!(incremental.lag >= 0.0) || !std::isfinite(incremental.lag)) {
-    *error = "incremental_lag must be finite and >= 0, got " +
-             FormatNumber(incremental.lag);
+  if (!CheckNonNegativeOption(incremental.lag, "incremental_lag", error)) {
     return false;
   }
   if (incremental.every > 0 && options.outer_rounds > 0) {
     *error =
-        "outer_rounds (spline refits of the whole run) cannot be "
-        "combined with the incremental mode";
+        OptionError("outer_rounds", std::to_string(options.outer_rounds),
+                    "refits the whole run, which the incremental mode "
+                    "(--incremental_every=" +
+                        std::to_string(incremental.every) + ") does not do",
+                    "0 there");
     return false;
   }
   // Every mean and pilot uses these, in the user's terms.
-  if (!CheckLocalizationOptions(options.localization, error)) {
-    *error = "prior mean '" + options.prior_mean + "': " + *error;
-    return false;
-  }
+  if (!CheckLocalizationOptions(options.localization, error)) return false;
   // Both priors' options, whichever is chosen (the RFF prior may start from
   // a WNOA solve): each model is built once on a unit window, so that the
   // checks are those of the real construction.
@@ -99,12 +98,9 @@ bool ValidateSlamOptions(const SlamOptions& options, std::string* error) {
   }
   if (!CheckCalibrationOptions(options.problem, error)) return false;
   std::unique_ptr<ceres::LossFunction> loss;
-  if (!CreateLoss(options.problem.loss, &loss, error)) return false;
-  if (!CreateLoss(options.problem.odometry_loss, &loss, error)) {
-    *error = "odometry loss: " + *error;
-    return false;
-  }
-  return true;
+  return CreateLoss(options.problem.loss, "loss", &loss, error) &&
+         CreateLoss(options.problem.odometry_loss, "odometry_loss", &loss,
+                    error);
 }
 
 }  // namespace rff

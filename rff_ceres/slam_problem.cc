@@ -14,17 +14,16 @@
 #include "costs/range_bearing_cost.h"
 #include "costs/range_cost.h"
 #include "rff_ceres/io/text_parser.h"
+#include "rff_ceres/option_error.h"
 
 namespace rff {
 
-bool CreateLoss(const LossOptions& options,
+bool CreateLoss(const LossOptions& options, const std::string& flag,
                 std::unique_ptr<ceres::LossFunction>* loss,
                 std::string* error) {
   loss->reset();
   if (options.name == "none") return true;
-  if (!(options.scale > 0.0) || !std::isfinite(options.scale)) {
-    *error = "loss scale must be a positive number, got " +
-             std::to_string(options.scale);
+  if (!CheckPositiveOption(options.scale, (flag + "_scale").c_str(), error)) {
     return false;
   }
   if (options.name == "huber") {
@@ -32,8 +31,8 @@ bool CreateLoss(const LossOptions& options,
   } else if (options.name == "cauchy" || options.name == "auto") {
     loss->reset(new ceres::CauchyLoss(options.scale));
   } else {
-    *error = "unknown loss '" + options.name +
-             "' (expected none, huber, cauchy or auto)";
+    *error = OptionError(flag, options.name, "unknown loss",
+                         "none, huber, cauchy or auto");
     return false;
   }
   return true;
@@ -107,20 +106,16 @@ bool CheckCalibrationOptions(const ProblemOptions& options,
       {"range_offset_sigma", options.range_calibration.offset_sigma},
       {"odometry_scale_sigma", options.odometry_calibration.scale_sigma}};
   for (const auto& [name, sigma] : sigmas) {
-    if (!(sigma > 0.0) || !std::isfinite(sigma)) {
-      *error = std::string(name) + " must be finite and > 0, got " +
-               FormatNumber(sigma);
-      return false;
-    }
+    if (!CheckPositiveOption(sigma, name, error)) return false;
   }
   return true;
 }
 
 bool SlamProblem::Begin(const std::vector<LandmarkId>& landmark_ids,
                         std::string* error) {
-  if (!CreateLoss(options_.loss, &loss_, error)) return false;
-  if (!CreateLoss(options_.odometry_loss, &odometry_loss_, error)) {
-    *error = "odometry loss: " + *error;
+  if (!CreateLoss(options_.loss, "loss", &loss_, error) ||
+      !CreateLoss(options_.odometry_loss, "odometry_loss", &odometry_loss_,
+                  error)) {
     return false;
   }
   for (const LandmarkId id : landmark_ids) slots_.emplace(id, 0);

@@ -32,8 +32,9 @@ struct LossOptions {
 };
 
 // Returns the loss (nullptr for "none"), or sets `error` for an unknown name
-// or a scale that is not positive.
-bool CreateLoss(const LossOptions& options,
+// or a scale that is not positive, naming the flags `flag` and
+// `flag`_scale ("loss" or "odometry_loss").
+bool CreateLoss(const LossOptions& options, const std::string& flag,
                 std::unique_ptr<ceres::LossFunction>* loss, std::string* error);
 
 // Self-calibration of the range sensor: the range of every RANGE and

@@ -18,6 +18,7 @@
 #include "rff_ceres/mean/prior_mean.h"
 #include "rff_ceres/mean/spline_mean.h"
 #include "rff_ceres/mean_rotation.h"
+#include "rff_ceres/option_error.h"
 #include "rff_ceres/posterior_covariance.h"
 #include "rff_ceres/variance_components.h"
 
@@ -52,6 +53,11 @@ class ProgressLogger : public ceres::IterationCallback {
   }
 };
 
+// The preconditioners a flag can choose (SUBSET cannot be set up from one).
+constexpr char kPreconditioners[] =
+    "auto, IDENTITY, JACOBI, SCHUR_JACOBI, CLUSTER_JACOBI or "
+    "CLUSTER_TRIDIAGONAL";
+
 }  // namespace
 
 bool ToCeresOptions(const SolverOptions& options,
@@ -62,9 +68,11 @@ bool ToCeresOptions(const SolverOptions& options,
                                                      : options.linear_solver;
   if (!ceres::StringToLinearSolverType(name,
                                        &ceres_options->linear_solver_type)) {
-    *error = "unknown linear solver '" + options.linear_solver +
-             "' (auto, DENSE_SCHUR, SPARSE_SCHUR, ITERATIVE_SCHUR, DENSE_QR, "
-             "DENSE_NORMAL_CHOLESKY, SPARSE_NORMAL_CHOLESKY, CGNR)";
+    *error = OptionError("linear_solver", options.linear_solver,
+                         "unknown linear solver",
+                         "auto, DENSE_SCHUR, SPARSE_SCHUR, ITERATIVE_SCHUR, "
+                         "DENSE_QR, DENSE_NORMAL_CHOLESKY, "
+                         "SPARSE_NORMAL_CHOLESKY or CGNR");
     return false;
   }
   // "auto": the preconditioner each iterative solver supports best.
@@ -75,51 +83,48 @@ bool ToCeresOptions(const SolverOptions& options,
   }
   if (!ceres::StringToPreconditionerType(name,
                                          &ceres_options->preconditioner_type)) {
-    *error = "unknown preconditioner '" + options.preconditioner +
-             "' (IDENTITY, JACOBI, SCHUR_JACOBI, CLUSTER_JACOBI, "
-             "CLUSTER_TRIDIAGONAL)";
+    *error = OptionError("preconditioner", options.preconditioner,
+                         "unknown preconditioner", kPreconditioners);
     return false;
   }
   // SUBSET needs residual blocks chosen for it, which no flag can give.
   if (ceres_options->preconditioner_type == ceres::SUBSET) {
-    *error =
-        "preconditioner SUBSET is not supported (it needs residual blocks "
-        "chosen for it); use IDENTITY, JACOBI, SCHUR_JACOBI, CLUSTER_JACOBI "
-        "or CLUSTER_TRIDIAGONAL";
+    *error = OptionError("preconditioner", options.preconditioner,
+                         "needs residual blocks chosen for it, which no flag "
+                         "gives",
+                         kPreconditioners);
     return false;
   }
   // Ceres 2.1's CGNR aborts on any other preconditioner.
   if (ceres_options->linear_solver_type == ceres::CGNR &&
       ceres_options->preconditioner_type != ceres::IDENTITY &&
       ceres_options->preconditioner_type != ceres::JACOBI) {
-    *error =
-        "linear solver CGNR supports the preconditioners IDENTITY and "
-        "JACOBI only, got '" +
-        options.preconditioner + "'";
+    *error = OptionError("preconditioner", options.preconditioner,
+                         "--linear_solver=CGNR takes IDENTITY or JACOBI only",
+                         "auto, IDENTITY or JACOBI with CGNR");
     return false;
   }
   name = options.trust_region_strategy;
   if (!ceres::StringToTrustRegionStrategyType(
           name, &ceres_options->trust_region_strategy_type)) {
-    *error = "unknown trust region strategy '" + options.trust_region_strategy +
-             "' (LEVENBERG_MARQUARDT, DOGLEG)";
+    *error = OptionError("trust_region_strategy", options.trust_region_strategy,
+                         "unknown trust region strategy",
+                         "LEVENBERG_MARQUARDT or DOGLEG");
     return false;
   }
-  if (options.num_threads < 1) {
-    *error = "num_threads must be >= 1";
-    return false;
-  }
-  if (options.max_iterations < 1) {
-    *error = "max_iterations must be >= 1";
-    return false;
-  }
-  for (const double tolerance :
-       {options.function_tolerance, options.gradient_tolerance,
-        options.parameter_tolerance}) {
-    if (!(tolerance >= 0.0) || !std::isfinite(tolerance)) {
-      *error = "solver tolerances must be finite and >= 0";
+  for (const auto& [flag, count] :
+       {std::pair("num_threads", options.num_threads),
+        std::pair("max_iterations", options.max_iterations)}) {
+    if (count < 1) {
+      *error = OptionError(flag, std::to_string(count), "", "1 or more");
       return false;
     }
+  }
+  for (const auto& [flag, tolerance] :
+       {std::pair("function_tolerance", options.function_tolerance),
+        std::pair("gradient_tolerance", options.gradient_tolerance),
+        std::pair("parameter_tolerance", options.parameter_tolerance)}) {
+    if (!CheckNonNegativeOption(tolerance, flag, error)) return false;
   }
   ceres_options->num_threads = options.num_threads;
   ceres_options->max_num_iterations = options.max_iterations;
@@ -168,7 +173,8 @@ std::unique_ptr<TrajectoryModel> CreateTrajectoryModel(
     for (const Observation& o : dataset.observations) times.push_back(o.t);
     model = WnoaTrajectory::Create(options.wnoa, mean, std::move(times), error);
   } else {
-    *error = "unknown prior '" + options.prior + "' (expected rff or wnoa)";
+    *error =
+        OptionError("prior", options.prior, "unknown prior", "rff or wnoa");
     return nullptr;
   }
   if (!model || SettlePriorMean(options, dataset) != "odometry") return model;
@@ -315,8 +321,7 @@ bool SolveBatch(const Dataset& dataset, const SlamOptions& options,
     ChooseLinearSolver(options.solver, *model, &ceres_options, result);
     SetOrdering(problem->get(), &ceres_options);
     if (!CheckLinearSystemFits(problem->get(), ceres_options,
-                               MemoryLimitBytes(options.solver.max_memory_gb),
-                               error)) {
+                               options.solver.max_memory_gb, error)) {
       return false;
     }
     ceres::Solve(ceres_options, (*problem)->problem(), &result->summary);
@@ -471,8 +476,7 @@ bool SolveIncremental(const Dataset& dataset, const SlamOptions& options,
     // The preprocessor edits the ordering it is given: a fresh one per solve.
     SetOrdering(&slam, &ceres_options);
     if (!CheckLinearSystemFits(&slam, ceres_options,
-                               MemoryLimitBytes(options.solver.max_memory_gb),
-                               error)) {
+                               options.solver.max_memory_gb, error)) {
       return false;
     }
     ceres::Solve(ceres_options, ceres_problem, &result->summary);

@@ -168,9 +168,8 @@ struct SlamResult {
 std::string SettlePriorMean(const SlamOptions& options, const Dataset& dataset);
 
 // Checks every option, of both priors whatever the chosen one, with the
-// message the user needs (the option's name, the allowed values or range and
-// the value given). RunSlam calls it first; apps call it before reading any
-// file.
+// message the user needs ("--flag=value: why; allowed range", option_error.h).
+// RunSlam calls it first; apps call it before reading any file.
 bool ValidateSlamOptions(const SlamOptions& options, std::string* error);
 
 // Runs the solve. Returns false with a message on bad options or input, and

@@ -6,6 +6,7 @@
 #include "costs/wnoa_initial_state_cost.h"
 #include "costs/wnoa_prior_cost.h"
 #include "rff_ceres/io/text_parser.h"
+#include "rff_ceres/option_error.h"
 
 namespace rff {
 namespace {
@@ -25,22 +26,18 @@ std::shared_ptr<const Eigen::VectorXd> RowPhi(int coordinate, double a,
 std::unique_ptr<WnoaTrajectory> WnoaTrajectory::Create(
     const WnoaOptions& options, std::shared_ptr<const MeanFunction> mean,
     std::vector<double> state_times, std::string* error) {
-  if (!CheckPositiveOption(options.position_qc, "wnoa position_qc", error) ||
-      !CheckPositiveOption(options.heading_qc, "wnoa heading_qc", error) ||
+  if (!CheckPositiveOption(options.position_qc, "wnoa_position_qc", error) ||
+      !CheckPositiveOption(options.heading_qc, "wnoa_heading_qc", error) ||
       !CheckPositiveOption(options.initial_position_sigma,
-                           "wnoa initial_position_sigma", error) ||
+                           "wnoa_initial_position_sigma", error) ||
       !CheckPositiveOption(options.initial_heading_sigma,
-                           "wnoa initial_heading_sigma", error) ||
+                           "wnoa_initial_heading_sigma", error) ||
       !CheckPositiveOption(options.initial_velocity_sigma,
-                           "wnoa initial_velocity_sigma", error) ||
+                           "wnoa_initial_velocity_sigma", error) ||
       !CheckPositiveOption(options.initial_angular_velocity_sigma,
-                           "wnoa initial_angular_velocity_sigma", error)) {
-    return nullptr;
-  }
-  if (!(std::isfinite(options.min_state_spacing) &&
-        options.min_state_spacing >= 0.0)) {
-    *error = "wnoa min_state_spacing must be finite and >= 0, got " +
-             FormatNumber(options.min_state_spacing);
+                           "wnoa_initial_angular_velocity_sigma", error) ||
+      !CheckNonNegativeOption(options.min_state_spacing,
+                              "wnoa_min_state_spacing", error)) {
     return nullptr;
   }
   if (!mean) {

@@ -56,15 +56,28 @@ TEST(ParseMethodsTest, RejectsUnknownEmptyAndDuplicateMethods) {
   std::vector<Method> methods;
   std::string error;
   EXPECT_FALSE(ParseMethods("rff,gpslam", &methods, &error));
-  EXPECT_THAT(error, StartsWith("unknown method 'gpslam'"));
+  EXPECT_EQ(error,
+            "--methods=rff,gpslam: unknown method gpslam; allowed a comma "
+            "list of rff, wnoa or name=flagfile-pattern (e.g. "
+            "mine=configs/{family}_mine.flags)");
   EXPECT_FALSE(ParseMethods("rff,rff", &methods, &error));
-  EXPECT_EQ(error, "method 'rff' is given twice");
+  EXPECT_EQ(error,
+            "--methods=rff,rff: method rff is given twice; allowed each "
+            "method once");
   EXPECT_FALSE(ParseMethods("=x.flags", &methods, &error));
-  EXPECT_EQ(error, "empty method name in '=x.flags'");
+  EXPECT_EQ(error,
+            "--methods==x.flags: a method has an empty name; allowed a comma "
+            "list of rff, wnoa or name=flagfile-pattern (e.g. "
+            "mine=configs/{family}_mine.flags)");
   EXPECT_FALSE(ParseMethods("a=", &methods, &error));
-  EXPECT_EQ(error, "method 'a' has an empty flagfile pattern");
+  EXPECT_EQ(error,
+            "--methods=a=: method a has an empty flagfile pattern; allowed a "
+            "comma list of rff, wnoa or name=flagfile-pattern (e.g. "
+            "mine=configs/{family}_mine.flags)");
   EXPECT_FALSE(ParseMethods("", &methods, &error));
-  EXPECT_EQ(error, "no method given");
+  EXPECT_EQ(error,
+            "--methods=: no method; allowed a comma list of rff, wnoa or "
+            "name=flagfile-pattern (e.g. mine=configs/{family}_mine.flags)");
 }
 
 TEST(MethodFlagfileTest, SubstitutesTheConfigsDirAndTheFamily) {
@@ -476,14 +489,17 @@ TEST(RffExperimentAppTest, BadFlagsExitWithAMessage) {
       testing::ReadFile(dir + "/err.txt")
           .substr(
               testing::ReadFile(dir + "/err.txt").find("rff_experiment: e")),
-      "rff_experiment: error: unknown experiment 'table3' (expected "
-      "table1, figure1, table2, figure2 or solvers)\n");
+      "rff_experiment: error: --experiments=table3: unknown experiment "
+      "table3; allowed a comma list of table1, figure1, table2, figure2 or "
+      "solvers\n");
   const std::string bad_method =
       binary + " --out_dir=" + dir + " --methods=gpslam 2> " + dir + "/err.txt";
   EXPECT_NE(std::system(bad_method.c_str()), 0);
   EXPECT_THAT(testing::ReadFile(dir + "/err.txt"),
-              HasSubstr("rff_experiment: error: --methods: unknown method "
-                        "'gpslam'"));
+              HasSubstr("rff_experiment: error: --methods=gpslam: unknown "
+                        "method gpslam; allowed a comma list of rff, wnoa or "
+                        "name=flagfile-pattern (e.g. "
+                        "mine=configs/{family}_mine.flags)\n"));
 }
 
 }  // namespace

@@ -127,7 +127,25 @@ TEST(FeatureTrajectoryTest, OverlapNotShorterThanTheSegmentFails) {
   EXPECT_EQ(FeatureTrajectory::Create(options, ZeroMean(), 0.0, 50.0, &error),
             nullptr);
   EXPECT_EQ(error,
-            "segment length and overlap must be >= 0, with overlap < length");
+            "--segment_overlap=10: allowed 0 or more, less than "
+            "--segment_length=10");
+}
+
+// The prior's weights are bounded by memory: the message gives the features
+// and the segment length that fit this run.
+TEST(FeatureTrajectoryTest, MoreWeightsThanMemoryAllowsFails) {
+  FeatureTrajectoryOptions options;
+  options.num_position_features = 1024;
+  options.num_heading_features = 1024;
+  options.segment_length = 1.0;
+  std::string error;
+  EXPECT_EQ(FeatureTrajectory::Create(options, ZeroMean(), 0.0, 100.0, &error),
+            nullptr);
+  EXPECT_EQ(error,
+            "--num_features=1024: the run's 100 s need 100 segments of 1024 "
+            "features (x, y) and 1024 (theta): more weights than memory "
+            "allows; allowed at most 816 (as many for theta) for this run, or "
+            "--segment_length of at least 1.5873015873015872");
 }
 
 }  // namespace

@@ -205,21 +205,21 @@ TEST(PerturbTest, RejectsBadOptionsWithExactMessages) {
   };
   const std::vector<Case> cases = {
       {[](PerturbOptions* o) { o->landmark_prior_offset = -1.0; },
-       "landmark_prior_offset must be in [0, 1e+06] m, got -1"},
+       "--landmark_prior_offset=-1: allowed 0 to 1e+06 m"},
       {[](PerturbOptions* o) { o->landmark_prior_offset = NAN; },
-       "landmark_prior_offset must be in [0, 1e+06] m, got nan"},
+       "--landmark_prior_offset=nan: allowed 0 to 1e+06 m"},
       {[](PerturbOptions* o) { o->landmark_prior_offset = INFINITY; },
-       "landmark_prior_offset must be in [0, 1e+06] m, got inf"},
+       "--landmark_prior_offset=inf: allowed 0 to 1e+06 m"},
       {[](PerturbOptions* o) { o->start_heading_offset_deg = NAN; },
-       "start_heading_offset_deg must be in [-360, 360] deg, got nan"},
+       "--start_heading_offset_deg=nan: allowed -360 to 360 degrees"},
       {[](PerturbOptions* o) { o->start_heading_offset_deg = -400.0; },
-       "start_heading_offset_deg must be in [-360, 360] deg, got -400"},
+       "--start_heading_offset_deg=-400: allowed -360 to 360 degrees"},
       {[](PerturbOptions* o) { o->start_heading_sigma = 0.0; },
-       "start_heading_sigma must be in (0, 1e+06] rad, got 0"},
+       "--start_heading_sigma=0: allowed more than 0 up to 1e+06 rad"},
       {[](PerturbOptions* o) { o->start_heading_sigma = -1.0; },
-       "start_heading_sigma must be in (0, 1e+06] rad, got -1"},
+       "--start_heading_sigma=-1: allowed more than 0 up to 1e+06 rad"},
       {[](PerturbOptions* o) { o->start_heading_sigma = -INFINITY; },
-       "start_heading_sigma must be in (0, 1e+06] rad, got -inf"},
+       "--start_heading_sigma=-inf: allowed more than 0 up to 1e+06 rad"},
   };
   for (const Case& c : cases) {
     PerturbOptions options;
@@ -299,18 +299,18 @@ TEST(PerturbFileTest, RefusesBadFilesAndWritesNothing) {
   };
   const std::vector<Case> cases = {
       {dir + "/in.rffd", dir + "/in.rffd", offset,
-       "output " + dir + "/in.rffd is the input file " + dir +
-           "/in.rffd; write the perturbed dataset elsewhere"},
+       "--output=" + dir + "/in.rffd: the same file as the input --input=" +
+           dir + "/in.rffd; allowed another path"},
       {dir + "/in.rffd", dir + "/./in.rffd", offset,
-       "output " + dir + "/./in.rffd is the input file " + dir +
-           "/in.rffd; write the perturbed dataset elsewhere"},
+       "--output=" + dir + "/./in.rffd: the same file as the input --input=" +
+           dir + "/in.rffd; allowed another path"},
       {dir + "/none.rffd", dir + "/out.rffd", offset,
        dir + "/none.rffd: cannot open for reading: No such file or directory"},
       {dir + "/in.rffd", dir + "/out.rffd", offset,
        dir + "/in.rffd: landmark_prior_offset=1 seed=1 moves the landmark "
              "priors, but there is no PRIOR_LANDMARK record"},
       {dir + "/in.rffd", dir + "/out.rffd", PerturbOptions{-2.0, 0.0, {}, 1},
-       "landmark_prior_offset must be in [0, 1e+06] m, got -2"},
+       "--landmark_prior_offset=-2: allowed 0 to 1e+06 m"},
       {dir + "/in.rffd", dir + "/no/such/dir/out.rffd", PerturbOptions(),
        dir + "/no/such/dir/out.rffd: cannot open for writing: No such file "
              "or directory"},

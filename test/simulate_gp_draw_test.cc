@@ -124,18 +124,28 @@ TEST(GpDrawOptionsTest, RejectsWhatCannotBeDrawn) {
   options.num_steps = kMaxGpDrawSteps + 1;
   EXPECT_FALSE(ValidateSimulationOptions(options, &error));
   EXPECT_EQ(error,
-            "num_steps must be at most 5000 for a GP draw (dense O(N^3) "
-            "factorisation), got 5001");
+            "--num_steps=5001: a GP draw factorises a dense N x N matrix, "
+            "O(N^3); allowed 1 to 5000 with --preset=gp_draw");
   options = GpDrawOptions(1);
   options.gp_heading_lengthscale = 0.0;
   EXPECT_FALSE(ValidateSimulationOptions(options, &error));
   EXPECT_EQ(error,
-            "gp_heading_lengthscale must be finite and > 0 (at most 1e+06), "
-            "got 0");
+            "--gp_heading_lengthscale=0: allowed more than 0 up to 1e+06");
   options = GpDrawOptions(1);
   options.gp_kernel = "cubic";
   EXPECT_FALSE(ValidateSimulationOptions(options, &error));
-  EXPECT_EQ(error.rfind("gp_kernel: ", 0), 0u) << error;
+  EXPECT_EQ(error,
+            "--gp_kernel=cubic: unknown kernel; allowed rbf, matern12, "
+            "matern32, matern52 or periodic");
+  // The heading's kernel is checked too, under its own flags.
+  options = GpDrawOptions(1);
+  options.gp_kernel = "periodic";
+  options.gp_heading_lengthscale = 1e-4;
+  EXPECT_FALSE(ValidateSimulationOptions(options, &error));
+  EXPECT_EQ(error,
+            "--gp_heading_lengthscale=1e-04: the periodic kernel's series "
+            "would need more than ~12000 terms; allowed 0.001 up to 1e+12 "
+            "for the periodic kernel");
 }
 
 }  // namespace

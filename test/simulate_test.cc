@@ -520,43 +520,46 @@ TEST(SimulateTest, RejectsBadOptionsWithAMessage) {
   };
   const std::vector<Case> cases = {
       {[](SimulationOptions* o) { o->num_steps = -3; },
-       "num_steps must be in [1, 10000000], got -3"},
+       "--num_steps=-3: allowed 1 to 10000000"},
       {[](SimulationOptions* o) { o->num_steps = 0; },
-       "num_steps must be in [1, 10000000], got 0"},
+       "--num_steps=0: allowed 1 to 10000000"},
       {[](SimulationOptions* o) { o->num_landmarks = 0; },
-       "landmarks must be in [1, 10000000], got 0"},
+       "--landmarks=0: allowed 1 to 10000000"},
       {[](SimulationOptions* o) { o->observations_per_step = -1; },
-       "observations_per_step must be in [1, 10000000], got -1"},
+       "--observations_per_step=-1: allowed 1 to 10000000"},
       {[](SimulationOptions* o) { o->sigma_range = 0.0; },
-       "sigma_range must be finite and > 0 (at most 1e+06), got 0"},
+       "--sigma_range=0: allowed more than 0 up to 1e+06"},
       {[](SimulationOptions* o) { o->sigma_bearing = -0.1; },
-       "sigma_bearing must be finite and > 0 (at most 1e+06), got -0.1"},
+       "--sigma_bearing=-0.1: allowed more than 0 up to 1e+06"},
       {[](SimulationOptions* o) { o->dt = NAN; },
-       "dt must be finite and > 0 (at most 1e+06), got nan"},
+       "--dt=nan: allowed more than 0 up to 1e+06"},
       {[](SimulationOptions* o) { o->odometry_sigma_theta = 0.0; },
-       "odometry_sigma_theta must be finite and > 0 (at most 1e+06), got 0"},
+       "--odometry_sigma_theta=0: allowed more than 0 up to 1e+06"},
       {[](SimulationOptions* o) { o->landmark_prior_sigma = -5.0; },
-       "landmark_prior_sigma must be finite and >= 0 (at most 1e+06), got -5"},
+       "--landmark_prior_sigma=-5: allowed 0 to 1e+06"},
       {[](SimulationOptions* o) { o->speed = INFINITY; },
-       "speed must be finite and >= 0 (at most 1e+06), got inf"},
+       "--speed=inf: allowed 0 to 1e+06"},
       {[](SimulationOptions* o) { o->preset = "two\nlines"; },
-       "preset must be one word of letters, digits, '_' or '-', got "
-       "'two\nlines'"},
+       "--preset=two\nlines: allowed one word of up to 64 letters, digits, "
+       "'_' or '-'"},
       {[](SimulationOptions* o) { o->field_of_view = 7.0; },
-       "field_of_view must be at most 2 pi, got 7"},
+       "--field_of_view=7: more than all around; allowed more than 0 up to 2 "
+       "pi"},
       {[](SimulationOptions* o) {
          o->sensor_range = 1.0;
          o->min_range = 2.0;
        },
-       "sensor_range must exceed min_range (2), got 1"},
+       "--sensor_range=1: sees nothing beyond --min_range=2; allowed 0 (every "
+       "landmark visible) or more than 2"},
       {[](SimulationOptions* o) { o->min_visible_landmarks = 60; },
-       "min_visible_landmarks (60) exceeds landmarks (50) and there is no "
-       "sensor_range to place more"},
+       "--min_visible_landmarks=60: more than --landmarks=50, and no "
+       "--sensor_range to place more; allowed at most 50"},
       {[](SimulationOptions* o) {
          o->num_steps = 10000000;
          o->num_landmarks = 10;
        },
-       "num_steps x observations_per_step exceeds 20000000 observations"},
+       "--observations_per_step=4: with --num_steps=10000000 more than "
+       "20000000 observations; allowed at most 2 for these steps"},
   };
   for (const Case& c : cases) {
     SimulationOptions options = PaperOptions(1);
@@ -586,8 +589,8 @@ TEST(SimulateTest, MeasurementKindNames) {
   EXPECT_EQ(MeasurementKindName(kind), "bearing");
   EXPECT_FALSE(ParseMeasurementKind("lidar", &kind, &error));
   EXPECT_EQ(error,
-            "unknown measurement kind 'lidar' (expected range, bearing or "
-            "range_bearing)");
+            "--kind=lidar: unknown measurement kind; allowed range, bearing or "
+            "range_bearing");
 }
 
 }  // namespace

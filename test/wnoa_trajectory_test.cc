@@ -68,37 +68,41 @@ TEST(WnoaTrajectoryTest, CreateRejectsBadOptions) {
   WnoaOptions options;
   options.position_qc = -1.0;
   EXPECT_EQ(CreateError(options, {0.0}),
-            "wnoa position_qc must be > 0, got -1");
+            "--wnoa_position_qc=-1: allowed more than 0");
   options = WnoaOptions();
   options.heading_qc = 0.0;
-  EXPECT_EQ(CreateError(options, {0.0}), "wnoa heading_qc must be > 0, got 0");
+  EXPECT_EQ(CreateError(options, {0.0}),
+            "--wnoa_heading_qc=0: allowed more than 0");
   options = WnoaOptions();
   options.heading_qc = NAN;
   EXPECT_EQ(CreateError(options, {0.0}),
-            "wnoa heading_qc must be > 0, got nan");
+            "--wnoa_heading_qc=nan: not a finite number; allowed more than "
+            "0");
   options = WnoaOptions();
   options.initial_position_sigma = INFINITY;
   EXPECT_EQ(CreateError(options, {0.0}),
-            "wnoa initial_position_sigma must be > 0, got inf");
+            "--wnoa_initial_position_sigma=inf: not a finite number; "
+            "allowed more than 0");
   options = WnoaOptions();
   options.initial_heading_sigma = -0.5;
   EXPECT_EQ(CreateError(options, {0.0}),
-            "wnoa initial_heading_sigma must be > 0, got -0.5");
+            "--wnoa_initial_heading_sigma=-0.5: allowed more than 0");
   options = WnoaOptions();
   options.initial_velocity_sigma = 0.0;
   EXPECT_EQ(CreateError(options, {0.0}),
-            "wnoa initial_velocity_sigma must be > 0, got 0");
+            "--wnoa_initial_velocity_sigma=0: allowed more than 0");
   options = WnoaOptions();
   options.initial_angular_velocity_sigma = -2.0;
   EXPECT_EQ(CreateError(options, {0.0}),
-            "wnoa initial_angular_velocity_sigma must be > 0, got -2");
+            "--wnoa_initial_angular_velocity_sigma=-2: allowed more than 0");
   options = WnoaOptions();
   options.min_state_spacing = -0.1;
   EXPECT_EQ(CreateError(options, {0.0}),
-            "wnoa min_state_spacing must be finite and >= 0, got -0.1");
+            "--wnoa_min_state_spacing=-0.1: allowed 0 or more");
   options.min_state_spacing = INFINITY;
   EXPECT_EQ(CreateError(options, {0.0}),
-            "wnoa min_state_spacing must be finite and >= 0, got inf");
+            "--wnoa_min_state_spacing=inf: not a finite number; allowed 0 or "
+            "more");
   options = WnoaOptions();
   EXPECT_EQ(CreateError(options, {}),
             "wnoa needs at least one state time, got none");

@@ -10,6 +10,7 @@
 
 #include "rff_ceres/convert/raw_records.h"
 #include "rff_ceres/io/text_parser.h"
+#include "rff_ceres/option_error.h"
 #include "rff_ceres/se2.h"
 #include "rff_ceres/statistics.h"
 
@@ -265,15 +266,18 @@ bool CheckOptions(const MrclamOptions& o, std::string* error) {
     return CheckNonNegativeOption(v, name, error);
   };
   if (o.robot < 1 || o.robot > kLastRobotSubject) {
-    *error = "mrclam_robot must be 1..5, got " + std::to_string(o.robot);
+    *error = OptionError("mrclam_robot", std::to_string(o.robot), "",
+                         "1 to " + std::to_string(kLastRobotSubject));
     return false;
   }
   if (!non_negative(o.odometry_interval, "mrclam_odometry_interval")) {
     return false;
   }
   if (o.odometry_interval > 0.0 && o.odometry_interval < 0.01) {
-    *error = "mrclam_odometry_interval must be 0 or >= 0.01 s, got " +
-             FormatNumber(o.odometry_interval);
+    *error = OptionError("mrclam_odometry_interval",
+                         FormatNumber(o.odometry_interval), "",
+                         "0 (poses at measurement times only) or 0.01 s or "
+                         "more");
     return false;
   }
   return positive(o.range_sigma, "mrclam_range_sigma") &&
@@ -368,12 +372,14 @@ bool ConvertMrclam(const std::string& directory, const MrclamOptions& options,
 
   std::vector<double> times;
   if (!TrajectoryTimes(measurement_times, options.odometry_interval, &times)) {
-    *error = robot + "_Measurement.dat: mrclam_odometry_interval " +
-             FormatNumber(options.odometry_interval) +
-             " s over the measurement times from " +
-             FormatNumber(measurement_times.front()) + " to " +
-             FormatNumber(measurement_times.back()) + " gives more than " +
-             FormatNumber(kMaxTrajectoryTimes) + " poses";
+    *error = OptionError(
+        "mrclam_odometry_interval", FormatNumber(options.odometry_interval),
+        "gives more than " + FormatNumber(kMaxTrajectoryTimes) +
+            " poses over the measurement times " +
+            FormatNumber(measurement_times.front()) + " to " +
+            FormatNumber(measurement_times.back()) + " of " + robot +
+            "_Measurement.dat",
+        "0 or a longer interval");
     return false;
   }
   summary->trajectory_times = times.size();

@@ -10,6 +10,7 @@
 
 #include "rff_ceres/convert/raw_records.h"
 #include "rff_ceres/io/text_parser.h"
+#include "rff_ceres/option_error.h"
 #include "rff_ceres/se2.h"
 #include "rff_ceres/statistics.h"
 
@@ -462,12 +463,14 @@ bool CheckOptions(const PlazaOptions& o, std::string* error) {
     return CheckNonNegativeOption(v, name, error);
   };
   if (o.name.empty()) {
-    *error = "the Plaza dataset name (file prefix) is empty";
+    *error = OptionError("plaza_name", o.name, "empty",
+                         "a file prefix such as Plaza1");
     return false;
   }
   if (o.heading_offset && !std::isfinite(*o.heading_offset)) {
-    *error = "plaza_heading_offset must be finite, got " +
-             FormatNumber(*o.heading_offset);
+    *error =
+        OptionError("plaza_heading_offset", FormatNumber(*o.heading_offset), "",
+                    "auto or a finite number [rad]");
     return false;
   }
   return positive(o.outlier_threshold, "plaza_outlier_threshold") &&
@@ -494,7 +497,8 @@ bool ParsePlazaCalibration(const std::string& text,
   } else if (text == "none") {
     *calibration = PlazaCalibration::kNone;
   } else {
-    *error = "unknown Plaza calibration '" + text + "' (use linear or none)";
+    *error = OptionError("plaza_calibration", text, "unknown calibration",
+                         "linear or none");
     return false;
   }
   return true;

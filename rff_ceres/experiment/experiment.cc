@@ -16,6 +16,7 @@
 #include "rff_ceres/io/output_file.h"
 #include "rff_ceres/io/text_parser.h"
 #include "rff_ceres/metrics.h"
+#include "rff_ceres/option_error.h"
 #include "rff_ceres/plot/svg_plot.h"
 #include "rff_ceres/simulate.h"
 #include "rff_ceres/statistics.h"
@@ -527,6 +528,11 @@ std::vector<RunRow> WithoutSolutions(std::vector<RunRow> rows) {
 // ---------------------------------------------------------------------------
 // Methods and datasets.
 
+// The values of --methods, for its messages.
+constexpr char kAllowedMethods[] =
+    "a comma list of rff, wnoa or name=flagfile-pattern (e.g. "
+    "mine=configs/{family}_mine.flags)";
+
 bool ParseMethods(const std::string& list, std::vector<Method>* methods,
                   std::string* error) {
   methods->clear();
@@ -542,31 +548,36 @@ bool ParseMethods(const std::string& list, std::vector<Method>* methods,
       } else if (item == "wnoa") {
         method.flagfile_pattern = "{configs}/{family}_wnoa.flags";
       } else if (!item.empty()) {
-        *error = "unknown method '" + item +
-                 "' (built in: rff, wnoa; others as name=flagfile-pattern, "
-                 "e.g. mine=configs/{family}_mine.flags)";
+        *error = OptionError("methods", list, "unknown method " + item,
+                             kAllowedMethods);
         return false;
       }
     } else {
       method.name = Trim(item.substr(0, equals));
       method.flagfile_pattern = Trim(item.substr(equals + 1));
       if (method.flagfile_pattern.empty()) {
-        *error = "method '" + method.name + "' has an empty flagfile pattern";
+        *error = OptionError(
+            "methods", list,
+            "method " + method.name + " has an empty flagfile pattern",
+            kAllowedMethods);
         return false;
       }
     }
     if (method.name.empty()) {
-      *error = "empty method name in '" + list + "'";
+      *error = OptionError("methods", list, "a method has an empty name",
+                           kAllowedMethods);
       return false;
     }
     if (!seen.insert(method.name).second) {
-      *error = "method '" + method.name + "' is given twice";
+      *error = OptionError("methods", list,
+                           "method " + method.name + " is given twice",
+                           "each method once");
       return false;
     }
     methods->push_back(method);
   }
   if (methods->empty()) {
-    *error = "no method given";
+    *error = OptionError("methods", list, "no method", kAllowedMethods);
     return false;
   }
   return true;
@@ -1150,18 +1161,26 @@ bool RunExperiments(const ExperimentConfig& config,
     *error = "no output directory";
     return false;
   }
+  // The flag's value as given, comma-separated.
+  std::string experiment_list;
+  for (const std::string& name : config.experiments) {
+    experiment_list += (experiment_list.empty() ? "" : ",") + name;
+  }
+  const std::string allowed =
+      "a comma list of " + JoinAlternatives(AllExperimentNames());
   std::set<std::string> selected;
   for (const std::string& name : config.experiments) {
     const auto& all = AllExperimentNames();
     if (std::find(all.begin(), all.end(), name) == all.end()) {
-      *error = "unknown experiment '" + name +
-               "' (expected table1, figure1, table2, figure2 or solvers)";
+      *error = OptionError("experiments", experiment_list,
+                           "unknown experiment " + name, allowed);
       return false;
     }
     selected.insert(name);
   }
   if (selected.empty()) {
-    *error = "no experiment selected";
+    *error =
+        OptionError("experiments", experiment_list, "no experiment", allowed);
     return false;
   }
 
@@ -1191,8 +1210,8 @@ bool RunExperiments(const ExperimentConfig& config,
         if (names.size() < 400) names += (names.empty() ? "" : ", ") + s.name;
       }
       if (figure2_spec.name.empty()) {
-        *error = "figure 2 dataset '" + config.figure2_dataset +
-                 "' is not one of " + names;
+        *error = OptionError("figure2_dataset", config.figure2_dataset,
+                             "not a dataset of the grids", names);
         return false;
       }
       experiment.datasets = {figure2_spec};

@@ -9,6 +9,8 @@
 #include "rff_ceres/features/qmc_features.h"
 #include "rff_ceres/features/rff_features.h"
 #include "rff_ceres/features/spectral_pair_features.h"
+#include "rff_ceres/io/text_parser.h"
+#include "rff_ceres/option_error.h"
 
 namespace rff {
 namespace {
@@ -33,13 +35,17 @@ const std::vector<FamilyEntry>& Registry() {
 }
 
 bool CheckOptions(const FeatureMapOptions& options, std::string* error) {
-  std::ostringstream message;
   if (options.num_features <= 0 || options.num_features > kMaxNumFeatures) {
-    message << options.family << ": num_features must be in [1, "
-            << kMaxNumFeatures << "], got " << options.num_features;
-  } else if (!std::isfinite(options.window_begin) ||
-             !std::isfinite(options.window_end) ||
-             !(options.window_end > options.window_begin)) {
+    *error = OptionError(options.num_features_flag,
+                         std::to_string(options.num_features), "",
+                         "1 to " + std::to_string(kMaxNumFeatures));
+    return false;
+  }
+  // The window comes from the caller's times, not from an option.
+  std::ostringstream message;
+  if (!std::isfinite(options.window_begin) ||
+      !std::isfinite(options.window_end) ||
+      !(options.window_end > options.window_begin)) {
     message << options.family << ": window [" << options.window_begin << ", "
             << options.window_end << "] must be finite with end > begin";
   } else if (std::max(std::abs(options.window_begin),
@@ -47,16 +53,11 @@ bool CheckOptions(const FeatureMapOptions& options, std::string* error) {
     message << options.family << ": window [" << options.window_begin << ", "
             << options.window_end << "] exceeds +-" << kMaxFeatureWindowTime
             << " s; pass times relative to the window origin";
-  } else if (!std::isfinite(options.hilbert_margin) ||
-             options.hilbert_margin < 0.0 ||
-             !std::isfinite(options.hilbert_min_margin) ||
-             options.hilbert_min_margin < 0.0) {
-    message << options.family
-            << ": hilbert_margin and hilbert_min_margin must be finite and "
-               ">= 0, got "
-            << options.hilbert_margin << " and " << options.hilbert_min_margin;
   } else {
-    return true;
+    return CheckNonNegativeOption(options.hilbert_margin, "hilbert_margin",
+                                  error) &&
+           CheckNonNegativeOption(options.hilbert_min_margin,
+                                  "hilbert_min_margin", error);
   }
   *error = message.str();
   return false;
@@ -92,12 +93,8 @@ std::unique_ptr<FeatureMap> CreateFeatureMap(const Kernel& kernel,
     }
     return entry.create(kernel, options, error);
   }
-  std::string known;
-  for (const std::string& name : FeatureFamilyNames()) {
-    known += (known.empty() ? "" : ", ") + name;
-  }
-  *error =
-      "unknown feature family '" + options.family + "' (known: " + known + ")";
+  *error = OptionError("features", options.family, "unknown feature family",
+                       JoinAlternatives(FeatureFamilyNames()));
   return nullptr;
 }
 

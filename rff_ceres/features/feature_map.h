@@ -59,6 +59,8 @@ struct FeatureMapOptions {
   // few lengthscales (4 of them: 1e-14 for rbf, 1e-5 matern32, 3e-4 matern12).
   double hilbert_margin = 0.1;
   double hilbert_min_margin = 4.0;  // lengthscales
+  // The flag that sets D, for messages ("num_heading_features" for theta).
+  std::string num_features_flag = "num_features";
 };
 
 // Builds the map. Unknown family, D out of range or of the wrong parity, an

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "rff_ceres/features/spectral_pair_features.h"
+#include "rff_ceres/option_error.h"
 
 namespace rff {
 
@@ -30,17 +31,18 @@ std::unique_ptr<FeatureMap> CreateGaussHermiteFeatures(
     const Kernel& kernel, const FeatureMapOptions& options,
     std::string* error) {
   if (!kernel.has_gaussian_spectrum()) {
+    const std::string why =
+        "needs a kernel with a Gaussian spectral density, got " + kernel.name();
     *error =
-        "gauss_hermite: needs a kernel with a Gaussian spectral density "
-        "(rbf), got " +
-        kernel.name();
+        OptionError("features", "gauss_hermite", why, "with rbf kernels only");
     return nullptr;
   }
   if (!CheckEvenNumFeatures(options, error)) return nullptr;
   if (options.num_features > kMaxGaussHermiteFeatures) {
-    *error = "gauss_hermite: num_features must be <= " +
-             std::to_string(kMaxGaussHermiteFeatures) + ", got " +
-             std::to_string(options.num_features);
+    *error = OptionError(options.num_features_flag,
+                         std::to_string(options.num_features),
+                         "gauss_hermite nodes come from a dense eigenproblem",
+                         "at most " + std::to_string(kMaxGaussHermiteFeatures));
     return nullptr;
   }
   const int n = options.num_features;

@@ -3,6 +3,8 @@
 #include <cmath>
 #include <utility>
 
+#include "rff_ceres/option_error.h"
+
 namespace rff {
 
 SpectralPairFeatures::SpectralPairFeatures(double centre, double constant,
@@ -44,9 +46,9 @@ double WindowCentre(const FeatureMapOptions& options) {
 bool CheckEvenNumFeatures(const FeatureMapOptions& options,
                           std::string* error) {
   if (options.num_features % 2 == 0) return true;
-  *error = options.family +
-           ": num_features must be even (cos/sin pairs), got " +
-           std::to_string(options.num_features);
+  *error = OptionError(
+      options.num_features_flag, std::to_string(options.num_features),
+      options.family + " features come in cos/sin pairs", "even numbers");
   return false;
 }
 
@@ -54,9 +56,10 @@ std::unique_ptr<FeatureMap> CreateFourierSeriesFeatures(
     const Kernel& kernel, const FeatureMapOptions& options,
     std::string* error) {
   if (options.num_features % 2 == 0) {
-    *error = kernel.name() +
-             " kernel: num_features must be odd (1 + 2 * harmonics), got " +
-             std::to_string(options.num_features);
+    *error = OptionError(
+        options.num_features_flag, std::to_string(options.num_features),
+        "the " + kernel.name() + " kernel's features are 1 + 2 x harmonics",
+        "odd numbers");
     return nullptr;
   }
   const int num_terms = (options.num_features + 1) / 2;

@@ -38,7 +38,8 @@ class SpectralPairFeatures : public FeatureMap {
 // The window centre, where every family puts its time origin.
 double WindowCentre(const FeatureMapOptions& options);
 
-// Fails with "<family>: num_features must be even (cos/sin pairs), got D".
+// Fails with "--num_features=D: <family> features come in cos/sin pairs;
+// allowed even numbers" (the flag of options.num_features_flag).
 bool CheckEvenNumFeatures(const FeatureMapOptions& options, std::string* error);
 
 // Kernels with a discrete spectrum (periodic), whatever the family: the first

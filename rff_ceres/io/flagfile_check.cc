@@ -4,6 +4,8 @@
 #include <fstream>
 #include <sstream>
 
+#include "rff_ceres/option_error.h"
+
 namespace rff {
 namespace {
 
@@ -49,23 +51,26 @@ bool CheckFlagfile(const std::string& path, const FlagIsKnown& is_known,
       std::filesystem::weakly_canonical(path, ec).string();
   for (const std::string& ancestor : *open) {
     if (ancestor == canonical) {
-      *error = "--flagfile=" + path + ": includes itself" +
-               (open->size() > 1 ? " through other flagfiles" : "");
+      *error = OptionError("flagfile", path,
+                           open->size() > 1
+                               ? "includes itself through other flagfiles"
+                               : "includes itself");
       return false;
     }
   }
   if (static_cast<int>(open->size()) >= kMaxFlagfileDepth) {
-    *error = "--flagfile=" + path + ": flagfiles nested more than " +
-             std::to_string(kMaxFlagfileDepth) + " deep";
+    *error = OptionError("flagfile", path,
+                         "flagfiles nested more than " +
+                             std::to_string(kMaxFlagfileDepth) + " deep");
     return false;
   }
   if (std::filesystem::is_directory(path, ec)) {
-    *error = "--flagfile=" + path + ": is a directory";
+    *error = OptionError("flagfile", path, "a directory", "a file path");
     return false;
   }
   std::ifstream in(path);
   if (!in) {
-    *error = "--flagfile=" + path + ": cannot open for reading";
+    *error = OptionError("flagfile", path, "cannot open for reading");
     return false;
   }
   open->push_back(canonical);

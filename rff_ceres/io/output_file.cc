@@ -11,6 +11,8 @@
 #include <filesystem>
 #include <utility>
 
+#include "rff_ceres/option_error.h"
+
 namespace rff {
 namespace {
 
@@ -40,31 +42,47 @@ bool IsUnder(const std::string& file, const std::string& directory) {
 
 std::string Named(const NamedPath& p) { return p.flag + "=" + p.path; }
 
+// The option message about `p` (its flag without the leading "--").
+std::string PathError(const NamedPath& p, const std::string& why,
+                      const std::string& allowed = "") {
+  const std::size_t dashes = p.flag.find_first_not_of('-');
+  const std::string flag =
+      dashes == std::string::npos ? p.flag : p.flag.substr(dashes);
+  // A name too long for the file system is cut for the message.
+  const std::string path =
+      p.path.size() > 200 ? p.path.substr(0, 200) + "..." : p.path;
+  return OptionError(flag, path, why, allowed);
+}
+
 bool CheckDirectory(const NamedPath& output, std::string* error) {
   std::error_code ec;
   if (fs::is_directory(output.path, ec)) {
-    *error = Named(output) + ": is a directory; give a file name";
+    *error = PathError(output, "a directory", "a file path");
     return false;
   }
   // Longer names fail only when the file is opened, after the work.
   const std::string name = fs::path(output.path).filename().string();
   if (name.size() > NAME_MAX) {
-    *error = Named(output).substr(0, 200) + "...: the file name is " +
-             std::to_string(name.size()) + " characters long, more than the " +
-             std::to_string(NAME_MAX) + " a file system allows";
+    *error = PathError(
+        output,
+        "the file name is " + std::to_string(name.size()) + " characters long",
+        "at most " + std::to_string(NAME_MAX) +
+            " characters, as the file system allows");
     return false;
   }
   fs::path directory = fs::path(output.path).parent_path();
   if (directory.empty()) directory = ".";
   if (!fs::is_directory(directory, ec)) {
     *error =
-        Named(output) + ": directory '" + directory.string() + "' " +
-        (fs::exists(directory, ec) ? "is not a directory" : "does not exist");
+        PathError(output, "directory '" + directory.string() + "' " +
+                              (fs::exists(directory, ec) ? "is not a directory"
+                                                         : "does not exist"));
     return false;
   }
   if (access(directory.c_str(), W_OK | X_OK) != 0) {
-    *error = Named(output) + ": directory '" + directory.string() +
-             "' is not writable: " + std::strerror(errno);
+    *error =
+        PathError(output, "directory '" + directory.string() +
+                              "' is not writable: " + std::strerror(errno));
     return false;
   }
   return true;
@@ -95,17 +113,19 @@ bool CheckOutputPaths(const std::vector<NamedPath>& inputs,
                           fs::exists(output.path, ec) &&
                           IsUnder(output.path, input.path);
       if (inside || SameFile(output.path, input.path)) {
-        *error = Named(output) + ": " +
-                 (inside ? "a file of the input directory "
-                         : "the same file as the input ") +
-                 Named(input) + "; refusing to overwrite an input";
+        *error = PathError(output,
+                           (inside ? "a file of the input directory "
+                                   : "the same file as the input ") +
+                               Named(input) + ", never overwritten",
+                           inside ? "a path outside it" : "another path");
         return false;
       }
     }
     for (const NamedPath* other : checked) {
       if (SameFile(output.path, other->path)) {
-        *error = Named(output) + ": the same file as the output " +
-                 Named(*other) + "; each output needs its own path";
+        *error =
+            PathError(output, "the same file as the output " + Named(*other),
+                      "a path of its own");
         return false;
       }
     }

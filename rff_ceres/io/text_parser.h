@@ -88,21 +88,6 @@ bool OpenForReading(const std::string& path, std::ifstream* stream,
 // "a", "a or b", "a, b or c": the allowed values of an option, for messages.
 std::string JoinAlternatives(const std::vector<std::string>& names);
 
-// Option checks (converters, trajectory models): `value` must be finite and
-// > 0 (>= 0); otherwise `error` names the option and the value.
-inline bool CheckPositiveOption(double value, const char* name,
-                                std::string* error) {
-  if (value > 0.0 && std::isfinite(value)) return true;
-  *error = std::string(name) + " must be > 0, got " + FormatNumber(value);
-  return false;
-}
-inline bool CheckNonNegativeOption(double value, const char* name,
-                                   std::string* error) {
-  if (value >= 0.0 && std::isfinite(value)) return true;
-  *error = std::string(name) + " must be >= 0, got " + FormatNumber(value);
-  return false;
-}
-
 }  // namespace rff
 
 #endif  // RFF_CERES_IO_TEXT_PARSER_H_

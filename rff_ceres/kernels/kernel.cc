@@ -2,11 +2,11 @@
 
 #include <cmath>
 #include <functional>
-#include <sstream>
 
 #include "rff_ceres/kernels/matern_kernel.h"
 #include "rff_ceres/kernels/periodic_kernel.h"
 #include "rff_ceres/kernels/rbf_kernel.h"
+#include "rff_ceres/option_error.h"
 
 namespace rff {
 namespace {
@@ -44,32 +44,20 @@ const std::vector<KernelEntry>& Registry() {
   return registry;
 }
 
-std::string JoinedNames() {
-  std::string joined;
-  for (const std::string& name : KernelNames()) {
-    joined += (joined.empty() ? "" : ", ") + name;
-  }
-  return joined;
-}
-
 // Beyond these the features' frequencies and weights leave double range
 // (1e12 s is 30000 years; 1e24 m^2 a spread of 1e12 m).
 constexpr double kMaxTimeScale = 1e12;
 constexpr double kMaxVariance = 1e24;
 
-bool CheckPositive(const char* what, double value, double largest,
+bool CheckPositive(const std::string& flag, double value, double largest,
                    std::string* error) {
-  std::ostringstream message;
-  if (!std::isfinite(value) || !(value > 0.0)) {
-    message << "kernel " << what << " must be positive and finite, got "
-            << value;
-  } else if (value > largest) {
-    message << "kernel " << what << " must be at most " << largest << ", got "
-            << value;
-  } else {
-    return true;
-  }
-  *error = message.str();
+  if (value > 0.0 && value <= largest) return true;
+  *error = OptionError(
+      flag, FormatNumber(value),
+      value > largest ? "the features' frequencies and weights leave double "
+                        "range"
+                      : "",
+      "more than 0 up to " + FormatNumber(largest));
   return false;
 }
 
@@ -92,12 +80,14 @@ bool Kernel::FourierSeries(int /*num_terms*/, std::vector<double>* frequencies,
 }
 
 std::unique_ptr<Kernel> CreateKernel(const KernelOptions& options,
-                                     std::string* error) {
+                                     std::string* error,
+                                     const std::string& flag_prefix) {
   for (const KernelEntry& entry : Registry()) {
     if (options.name != entry.name) continue;
-    if (!CheckPositive("variance", options.variance, kMaxVariance, error) ||
-        !CheckPositive("lengthscale", options.lengthscale, kMaxTimeScale,
-                       error)) {
+    if (!CheckPositive(flag_prefix + "kernel_variance", options.variance,
+                       kMaxVariance, error) ||
+        !CheckPositive(flag_prefix + "lengthscale", options.lengthscale,
+                       kMaxTimeScale, error)) {
       return nullptr;
     }
     if (options.name == "periodic") {
@@ -105,18 +95,20 @@ std::unique_ptr<Kernel> CreateKernel(const KernelOptions& options,
         return nullptr;
       }
       // Below this the series needs more than ~12000 terms (white noise).
-      if (options.lengthscale < 1e-3) {
-        std::ostringstream message;
-        message << "periodic kernel lengthscale must be >= 0.001, got "
-                << options.lengthscale;
-        *error = message.str();
+      constexpr double kMinPeriodicLengthscale = 1e-3;
+      if (options.lengthscale < kMinPeriodicLengthscale) {
+        *error = OptionError(
+            flag_prefix + "lengthscale", FormatNumber(options.lengthscale),
+            "the periodic kernel's series would need more than ~12000 terms",
+            FormatNumber(kMinPeriodicLengthscale) + " up to " +
+                FormatNumber(kMaxTimeScale) + " for the periodic kernel");
         return nullptr;
       }
     }
     return entry.create(options);
   }
-  *error =
-      "unknown kernel '" + options.name + "' (known: " + JoinedNames() + ")";
+  *error = OptionError(flag_prefix + "kernel", options.name, "unknown kernel",
+                       JoinAlternatives(KernelNames()));
   return nullptr;
 }
 

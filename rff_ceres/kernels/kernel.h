@@ -69,9 +69,13 @@ struct KernelOptions {
 };
 
 // Builds a kernel by name. Unknown name, or a variance, lengthscale or period
-// that is not positive and finite: returns nullptr and fills `error`.
+// that is not positive and finite: returns nullptr and fills `error`. The
+// message names the flags PREFIXkernel, PREFIXkernel_variance,
+// PREFIXlengthscale and period, for PREFIX = `flag_prefix` ("heading_" for
+// theta, "gp_" for rff_simulate's GP draw).
 std::unique_ptr<Kernel> CreateKernel(const KernelOptions& options,
-                                     std::string* error);
+                                     std::string* error,
+                                     const std::string& flag_prefix = "");
 
 // The registered names, in registry order.
 std::vector<std::string> KernelNames();

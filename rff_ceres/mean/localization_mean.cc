@@ -10,6 +10,7 @@
 #include "rff_ceres/dead_reckoning.h"
 #include "rff_ceres/io/text_parser.h"
 #include "rff_ceres/mean/spline_mean.h"
+#include "rff_ceres/option_error.h"
 
 namespace rff {
 
@@ -323,9 +324,8 @@ bool CheckLocalizationOptions(const LocalizationOptions& options,
         std::make_pair("heading_smoothing", options.heading_smoothing),
         std::make_pair("correction_smoothing", options.correction_smoothing),
         std::make_pair("held_heading_sigma", options.held_heading_sigma)}) {
-    if (!(value > 0.0) || !std::isfinite(value)) {
-      *error = std::string("localization_") + name +
-               " must be finite and > 0, got " + FormatNumber(value);
+    if (!CheckPositiveOption(
+            value, (std::string("localization_") + name).c_str(), error)) {
       return false;
     }
   }
@@ -336,11 +336,8 @@ std::shared_ptr<const MeanFunction> BuildLocalizationMean(
     const Dataset& dataset, const LocalizationOptions& options,
     LocalizationReport* report, std::string* error) {
   *report = LocalizationReport();
+  if (!CheckLocalizationOptions(options, error)) return nullptr;
   const std::string prefix = "prior mean 'localization': ";
-  if (!CheckLocalizationOptions(options, error)) {
-    *error = prefix + *error;
-    return nullptr;
-  }
   std::map<LandmarkId, KnownLandmark> landmarks;
   for (const LandmarkPrior& l : dataset.landmark_priors) {
     landmarks[l.id] = {Eigen::Vector2d(l.x, l.y), l.sigma};

@@ -6,6 +6,7 @@
 #include "rff_ceres/io/text_parser.h"
 #include "rff_ceres/mean/localization_mean.h"
 #include "rff_ceres/mean/spline_mean.h"
+#include "rff_ceres/option_error.h"
 
 namespace rff {
 
@@ -26,22 +27,19 @@ std::shared_ptr<const MeanFunction> BuildPriorMean(
     std::string* error) {
   const std::vector<std::string> names = PriorMeanNames();
   if (std::find(names.begin(), names.end(), name) == names.end()) {
-    *error = "unknown prior mean '" + name + "' (expected " +
-             JoinAlternatives(PriorMeanNames()) + ")";
+    *error = OptionError("prior_mean", name, "unknown prior mean",
+                         JoinAlternatives(PriorMeanNames()));
     return nullptr;
   }
   // Checked whatever the name: "auto" and "spline" may localise.
-  if (!CheckLocalizationOptions(localization, error)) {
-    *error = "prior mean '" + name + "': " + *error;
-    return nullptr;
-  }
+  if (!CheckLocalizationOptions(localization, error)) return nullptr;
   if (dataset.pose_priors.empty()) {
     *error = "prior mean '" + name + "': the dataset has no PRIOR_POSE record";
     return nullptr;
   }
   if (name == "wnoa") {
-    *error =
-        "prior mean 'wnoa' is a solve of the WNOA prior: RunSlam builds it";
+    *error = OptionError("prior_mean", name,
+                         "a solve of the WNOA prior, which RunSlam builds");
     return nullptr;
   }
   // From the inputs only: observations in the mean would count twice.

@@ -285,16 +285,17 @@ TEST(MrclamConvertTest, MissingFileAndBadOptions) {
                        "such file or directory");
   options.robot = 6;
   EXPECT_FALSE(ConvertMrclam(dir, options, &d, &s, &error));
-  EXPECT_EQ(error, "mrclam_robot must be 1..5, got 6");
+  EXPECT_EQ(error, "--mrclam_robot=6: allowed 1 to 5");
   options.robot = 1;
   options.odometry_interval = 0.005;
   EXPECT_FALSE(ConvertMrclam(dir, options, &d, &s, &error));
   EXPECT_EQ(error,
-            "mrclam_odometry_interval must be 0 or >= 0.01 s, got 0.005");
+            "--mrclam_odometry_interval=0.005: allowed 0 (poses at "
+            "measurement times only) or 0.01 s or more");
   options.odometry_interval = 0.0;
   options.bearing_sigma = -1.0;
   EXPECT_FALSE(ConvertMrclam(dir, options, &d, &s, &error));
-  EXPECT_EQ(error, "mrclam_bearing_sigma must be > 0, got -1");
+  EXPECT_EQ(error, "--mrclam_bearing_sigma=-1: allowed more than 0");
 }
 
 // GT_POSE pose at time t by linear interpolation (t inside the rows).

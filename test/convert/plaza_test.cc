@@ -230,7 +230,9 @@ TEST(PlazaConvertTest, ParsesCalibrationName) {
   ASSERT_TRUE(ParsePlazaCalibration("linear", &c, &error));
   EXPECT_EQ(c, PlazaCalibration::kLinear);
   EXPECT_FALSE(ParsePlazaCalibration("robust", &c, &error));
-  EXPECT_EQ(error, "unknown Plaza calibration 'robust' (use linear or none)");
+  EXPECT_EQ(error,
+            "--plaza_calibration=robust: unknown calibration; allowed linear "
+            "or none");
 }
 
 // Runs the converter on the small input after replacing one file.
@@ -301,7 +303,12 @@ TEST(PlazaConvertTest, RejectsBadOptions) {
   PlazaSummary s;
   std::string error;
   EXPECT_FALSE(ConvertPlaza("/nonexistent", options, &d, &s, &error));
-  EXPECT_EQ(error, "plaza_odom_sigma_xy_floor must be > 0, got 0");
+  EXPECT_EQ(error, "--plaza_odom_sigma_xy_floor=0: allowed more than 0");
+  options = PlazaOptions();
+  options.name = "";
+  EXPECT_FALSE(ConvertPlaza("/nonexistent", options, &d, &s, &error));
+  EXPECT_EQ(error,
+            "--plaza_name=: empty; allowed a file prefix such as Plaza1");
 }
 
 // A raw Plaza recording whose odometry frame is the GT heading frame turned

@@ -77,26 +77,31 @@ TEST(FeatureMapTest, RejectsBadOptions) {
   const auto matern = MakeKernel("matern32");
   const auto periodic = MakeKernel("periodic", 1.0);
   EXPECT_EQ(CreateError(*rbf, Options("fourier", 16)),
-            "unknown feature family 'fourier' (known: rff, qmc, "
-            "gauss_hermite, hilbert)");
+            "--features=fourier: unknown feature family; allowed rff, qmc, "
+            "gauss_hermite or hilbert");
   EXPECT_EQ(CreateError(*rbf, Options("rff", 0)),
-            "rff: num_features must be in [1, 65536], got 0");
+            "--num_features=0: allowed 1 to 65536");
   EXPECT_EQ(CreateError(*rbf, Options("hilbert", -4)),
-            "hilbert: num_features must be in [1, 65536], got -4");
+            "--num_features=-4: allowed 1 to 65536");
   EXPECT_EQ(CreateError(*rbf, Options("qmc", 1 << 20)),
-            "qmc: num_features must be in [1, 65536], got 1048576");
+            "--num_features=1048576: allowed 1 to 65536");
   EXPECT_EQ(CreateError(*rbf, Options("rff", 33)),
-            "rff: num_features must be even (cos/sin pairs), got 33");
+            "--num_features=33: rff features come in cos/sin pairs; allowed "
+            "even numbers");
   EXPECT_EQ(CreateError(*matern, Options("qmc", 9)),
-            "qmc: num_features must be even (cos/sin pairs), got 9");
+            "--num_features=9: qmc features come in cos/sin pairs; allowed "
+            "even numbers");
   EXPECT_EQ(CreateError(*matern, Options("gauss_hermite", 16)),
-            "gauss_hermite: needs a kernel with a Gaussian spectral density "
-            "(rbf), got matern32");
+            "--features=gauss_hermite: needs a kernel with a Gaussian "
+            "spectral density, got matern32; allowed with rbf kernels only");
   EXPECT_EQ(CreateError(*rbf, Options("gauss_hermite", 2048)),
-            "gauss_hermite: num_features must be <= 1024, got 2048");
-  EXPECT_EQ(CreateError(*periodic, Options("hilbert", 16)),
-            "periodic kernel: num_features must be odd (1 + 2 * harmonics), "
-            "got 16");
+            "--num_features=2048: gauss_hermite nodes come from a dense "
+            "eigenproblem; allowed at most 1024");
+  FeatureMapOptions heading = Options("hilbert", 16);
+  heading.num_features_flag = "num_heading_features";
+  EXPECT_EQ(CreateError(*periodic, heading),
+            "--num_heading_features=16: the periodic kernel's features are "
+            "1 + 2 x harmonics; allowed odd numbers");
 
   FeatureMapOptions options = Options("hilbert", 16);
   options.window_end = 0.0;
@@ -117,8 +122,12 @@ TEST(FeatureMapTest, RejectsBadOptions) {
   options = Options("hilbert", 16);
   options.hilbert_margin = -0.1;
   EXPECT_EQ(CreateError(*rbf, options),
-            "hilbert: hilbert_margin and hilbert_min_margin must be finite "
-            "and >= 0, got -0.1 and 4");
+            "--hilbert_margin=-0.1: allowed 0 or more");
+  options.hilbert_margin = 0.1;
+  options.hilbert_min_margin = NAN;
+  EXPECT_EQ(CreateError(*rbf, options),
+            "--hilbert_min_margin=nan: not a finite number; allowed 0 or "
+            "more");
 }
 
 // The acceptance table of docs/features.md, asserted: short-lag error of

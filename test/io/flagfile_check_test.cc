@@ -68,7 +68,7 @@ TEST(FlagfileCheckTest, AMissingFileOrDirectoryIsAnError) {
   EXPECT_EQ(Check({"--flagfile=" + dir + "/none.flags"}),
             "--flagfile=" + dir + "/none.flags: cannot open for reading");
   EXPECT_EQ(Check({"--flagfile=" + dir}),
-            "--flagfile=" + dir + ": is a directory");
+            "--flagfile=" + dir + ": a directory; allowed a file path");
 }
 
 }  // namespace

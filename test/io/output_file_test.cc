@@ -105,7 +105,7 @@ TEST(CheckOutputPathsTest, RefusesAnInputUnderAnySpelling) {
         << output;
     EXPECT_EQ(error, "--output_trajectory=" + output +
                          ": the same file as the input --dataset=" + dir +
-                         "/in.rffd; refusing to overwrite an input");
+                         "/in.rffd, never overwritten; allowed another path");
   }
 }
 
@@ -116,7 +116,7 @@ TEST(CheckOutputPathsTest, RefusesTwoOutputsOnOnePath) {
       {}, {{"--a", dir + "/o.txt"}, {"--b", ""}, {"--c", dir + "/./o.txt"}},
       &error));
   EXPECT_EQ(error, "--c=" + dir + "/./o.txt: the same file as the output --a=" +
-                       dir + "/o.txt; each output needs its own path");
+                       dir + "/o.txt; allowed a path of its own");
 }
 
 TEST(CheckOutputPathsTest, RefusesAFileOfAnInputDirectory) {
@@ -126,9 +126,11 @@ TEST(CheckOutputPathsTest, RefusesAFileOfAnInputDirectory) {
   std::string error;
   EXPECT_FALSE(CheckOutputPaths({{"--input", dir + "/raw"}},
                                 {{"--output", dir + "/raw/GT.txt"}}, &error));
-  EXPECT_EQ(error, "--output=" + dir +
-                       "/raw/GT.txt: a file of the input directory --input=" +
-                       dir + "/raw; refusing to overwrite an input");
+  EXPECT_EQ(error,
+            "--output=" + dir +
+                "/raw/GT.txt: a file of the input directory --input=" + dir +
+                "/raw, never overwritten; allowed a path outside "
+                "it");
   // A new file beside the raw ones overwrites nothing.
   EXPECT_TRUE(CheckOutputPaths({{"--input", dir + "/raw"}},
                                {{"--output", dir + "/raw/new.rffd"}}, &error))
@@ -146,14 +148,14 @@ TEST(CheckOutputPathsTest, ChecksTheDirectoryBeforeAnyWork) {
   EXPECT_EQ(error, "--o=" + dir + "/file/o.txt: directory '" + dir +
                        "/file' is not a directory");
   EXPECT_FALSE(CheckOutputPaths({}, {{"--o", dir}}, &error));
-  EXPECT_EQ(error, "--o=" + dir + ": is a directory; give a file name");
+  EXPECT_EQ(error, "--o=" + dir + ": a directory; allowed a file path");
   EXPECT_TRUE(CheckOutputPaths({}, {{"--o", dir + "/o.txt"}}, &error)) << error;
   // A name longer than the file system allows fails here, not after a solve.
   const std::string long_name(300, 'x');
   EXPECT_FALSE(CheckOutputPaths({}, {{"--o", long_name}}, &error));
-  EXPECT_EQ(error, "--o=" + long_name.substr(0, 196) +
-                       "...: the file name is 300 characters long, more "
-                       "than the 255 a file system allows");
+  EXPECT_EQ(error, "--o=" + long_name.substr(0, 200) +
+                       "...: the file name is 300 characters long; allowed "
+                       "at most 255 characters, as the file system allows");
 }
 
 }  // namespace

@@ -62,31 +62,50 @@ TEST(KernelTest, RejectsBadOptions) {
   KernelOptions options;
   options.name = "gaussian";
   EXPECT_EQ(CreateError(options),
-            "unknown kernel 'gaussian' (known: rbf, matern12, matern32, "
-            "matern52, periodic)");
+            "--kernel=gaussian: unknown kernel; allowed rbf, matern12, "
+            "matern32, matern52 or periodic");
   options.name = "matern32";
   options.lengthscale = 0.0;
   EXPECT_EQ(CreateError(options),
-            "kernel lengthscale must be positive and finite, got 0");
+            "--lengthscale=0: allowed more than 0 up to 1e+12");
   options.lengthscale = NAN;
   EXPECT_EQ(CreateError(options),
-            "kernel lengthscale must be positive and finite, got nan");
+            "--lengthscale=nan: allowed more than 0 up to 1e+12");
   options.lengthscale = 1.0;
   options.variance = -2.0;
   EXPECT_EQ(CreateError(options),
-            "kernel variance must be positive and finite, got -2");
+            "--kernel_variance=-2: allowed more than 0 up to 1e+24");
   options.variance = INFINITY;
   EXPECT_EQ(CreateError(options),
-            "kernel variance must be positive and finite, got inf");
+            "--kernel_variance=inf: the features' frequencies and weights "
+            "leave double range; allowed more than 0 up to 1e+24");
   options = KernelOptions();
   options.name = "periodic";
   options.period = 0.0;
   EXPECT_EQ(CreateError(options),
-            "kernel period must be positive and finite, got 0");
+            "--period=0: allowed more than 0 up to 1e+12");
   options.period = 1.0;
   options.lengthscale = 1e-4;
   EXPECT_EQ(CreateError(options),
-            "periodic kernel lengthscale must be >= 0.001, got 0.0001");
+            "--lengthscale=1e-04: the periodic kernel's series would need "
+            "more than ~12000 terms; allowed 0.001 up to 1e+12 for the "
+            "periodic kernel");
+}
+
+// The flags of the heading kernel and of the GP draw are named by prefix.
+TEST(KernelTest, MessagesNameTheFlagsOfThePrefix) {
+  KernelOptions options;
+  options.name = "sinc";
+  std::string error;
+  EXPECT_EQ(CreateKernel(options, &error, "heading_"), nullptr);
+  EXPECT_EQ(error,
+            "--heading_kernel=sinc: unknown kernel; allowed rbf, matern12, "
+            "matern32, matern52 or periodic");
+  options = KernelOptions();
+  options.variance = 0.0;
+  EXPECT_EQ(CreateKernel(options, &error, "gp_heading_"), nullptr);
+  EXPECT_EQ(error,
+            "--gp_heading_kernel_variance=0: allowed more than 0 up to 1e+24");
 }
 
 TEST(KernelTest, EvaluatesClosedForms) {

@@ -153,8 +153,8 @@ TEST(PriorMeanTest, RegistryRejectsUnknownNames) {
   std::string error;
   EXPECT_EQ(BuildPriorMean("magic", dataset, &error), nullptr);
   EXPECT_EQ(error,
-            "unknown prior mean 'magic' (expected auto, odometry, wnoa, "
-            "localization, spline or constant)");
+            "--prior_mean=magic: unknown prior mean; allowed auto, odometry, "
+            "wnoa, localization, spline or constant");
   EXPECT_THAT(PriorMeanNames(), ::testing::Contains("localization"));
   // Odometry is asked for but the dataset has none.
   EXPECT_EQ(BuildPriorMean("odometry", dataset, &error), nullptr);
@@ -248,8 +248,7 @@ TEST(PriorMeanTest, BadLocalizationOptionsAreNamedForEveryMean) {
                            kPaperSplineSmoothing, &error),
             nullptr);
   EXPECT_EQ(error,
-            "prior mean 'localization': localization_correction_smoothing "
-            "must be finite and > 0, got 0");
+            "--localization_correction_smoothing=0: allowed more than 0");
   // "auto" would localise without odometry: it must not fall back silently.
   options = LocalizationOptions();
   options.position_smoothing = std::nan("");
@@ -257,13 +256,14 @@ TEST(PriorMeanTest, BadLocalizationOptionsAreNamedForEveryMean) {
       BuildPriorMean("auto", dataset, options, kPaperSplineSmoothing, &error),
       nullptr);
   EXPECT_EQ(error,
-            "prior mean 'auto': localization_position_smoothing must be "
-            "finite and > 0, got nan");
+            "--localization_position_smoothing=nan: not a finite number; "
+            "allowed more than 0");
   options = LocalizationOptions();
   options.held_heading_sigma = -0.1;
   LocalizationReport report;
   EXPECT_EQ(BuildLocalizationMean(dataset, options, &report, &error), nullptr);
-  EXPECT_THAT(error, HasSubstr("localization_held_heading_sigma"));
+  EXPECT_EQ(error,
+            "--localization_held_heading_sigma=-0.1: allowed more than 0");
 }
 
 }  // namespace

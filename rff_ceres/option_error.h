@@ -1,0 +1,48 @@
+// The one form of every message about a bad option or flag value:
+//
+//   --flag=value: why; allowed range
+//
+// so that the user sees the spelling to change, what it was, and what it may
+// be. Library options are named by the flag that sets them (apps/*.cc).
+#ifndef RFF_CERES_OPTION_ERROR_H_
+#define RFF_CERES_OPTION_ERROR_H_
+
+#include <cmath>
+#include <string>
+
+#include "rff_ceres/io/text_parser.h"  // FormatNumber, for the values.
+
+namespace rff {
+
+// `flag` without the leading "--"; `value` as given (a double through
+// FormatNumber); an empty `why` or `allowed` is left out.
+inline std::string OptionError(const std::string& flag,
+                               const std::string& value, const std::string& why,
+                               const std::string& allowed = "") {
+  std::string message = "--" + flag + "=" + value + ":";
+  if (!why.empty()) message += " " + why + (allowed.empty() ? "" : ";");
+  if (!allowed.empty()) message += " allowed " + allowed;
+  return message;
+}
+
+// `value` must be finite and > 0 (>= 0); otherwise `error` names the flag.
+inline bool CheckPositiveOption(double value, const char* flag,
+                                std::string* error) {
+  if (value > 0.0 && std::isfinite(value)) return true;
+  *error = OptionError(flag, FormatNumber(value),
+                       std::isfinite(value) ? "" : "not a finite number",
+                       "more than 0");
+  return false;
+}
+inline bool CheckNonNegativeOption(double value, const char* flag,
+                                   std::string* error) {
+  if (value >= 0.0 && std::isfinite(value)) return true;
+  *error = OptionError(flag, FormatNumber(value),
+                       std::isfinite(value) ? "" : "not a finite number",
+                       "0 or more");
+  return false;
+}
+
+}  // namespace rff
+
+#endif  // RFF_CERES_OPTION_ERROR_H_
