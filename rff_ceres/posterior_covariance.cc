@@ -67,6 +67,34 @@ std::string SingularMessage(SlamProblem* problem,
   return message;
 }
 
+// The Jacobian of every residual (through its loss) with the columns in
+// LandmarksLast's order, and each parameter block's first column.
+struct LinearizedProblem {
+  RowMajorSparse jacobian;
+  std::map<const double*, int> offsets;
+};
+
+// False where a block is held constant or the problem cannot be evaluated
+// (ceres::Covariance evaluates it again and reports).
+bool LinearizeLandmarksLast(SlamProblem* problem, LinearizedProblem* out) {
+  ceres::Problem* ceres_problem = problem->problem();
+  int t = 0;
+  const std::vector<double*> columns = LandmarksLast(problem, &t);
+  int at = 0;
+  for (double* block : columns) {
+    if (ceres_problem->IsParameterBlockConstant(block)) return false;
+    out->offsets[block] = at;
+    at += ceres_problem->ParameterBlockSize(block);
+  }
+  std::vector<ceres::ResidualBlockId> ids;
+  ceres_problem->GetResidualBlocks(&ids);
+  double cost = 0.0;
+  Eigen::VectorXd residuals;
+  std::string why_not;
+  return Linearize(ceres_problem, ids, &cost, &residuals, &out->jacobian,
+                   &why_not, columns);
+}
+
 // Sigma(a, b) of the trajectory block pairs (a <= b) and the landmarks'.
 struct CovarianceBlocks {
   std::map<std::pair<int, int>, Eigen::MatrixXd> trajectory;
@@ -83,31 +111,16 @@ bool SchurCovariance(SlamProblem* problem, const TrajectoryModel& model,
                      CovarianceBlocks* blocks) {
   ceres::Problem* ceres_problem = problem->problem();
   int t = 0;
-  const std::vector<double*> columns = LandmarksLast(problem, &t);
+  LandmarksLast(problem, &t);
   if (!SchurFormFits(t, ceres_problem->NumParameters() - t)) return false;
-  for (double* block : columns) {
-    if (ceres_problem->IsParameterBlockConstant(block)) return false;
-  }
-  std::vector<ceres::ResidualBlockId> ids;
-  ceres_problem->GetResidualBlocks(&ids);
-  double cost = 0.0;
-  Eigen::VectorXd residuals;
-  RowMajorSparse jacobian;
-  std::string why_not;
-  if (!Linearize(ceres_problem, ids, &cost, &residuals, &jacobian, &why_not,
-                 columns)) {
-    return false;  // Ceres evaluates it again and reports.
-  }
+  LinearizedProblem linearized;
+  if (!LinearizeLandmarksLast(problem, &linearized)) return false;
+  const std::map<const double*, int>& offset = linearized.offsets;
   // Not structured or not positive definite: the QR of J (Ceres) decides,
   // and names the landmarks the data leave free.
-  const GaussNewtonSystem system(jacobian, t, /*sparse_fallback=*/false);
+  const GaussNewtonSystem system(linearized.jacobian, t,
+                                 /*sparse_fallback=*/false);
   if (!system.structured() || !system.positive_definite()) return false;
-  std::map<const double*, int> offset;
-  int at = 0;
-  for (double* block : columns) {
-    offset[block] = at;
-    at += ceres_problem->ParameterBlockSize(block);
-  }
   const Eigen::MatrixXd leading = system.LeadingCovariance();
   for (const auto& [a, b] : block_pairs) {
     blocks->trajectory[{a, b}] =
@@ -133,27 +146,11 @@ bool SelectedInverseCovariance(SlamProblem* problem,
                                const std::vector<Landmark>& landmarks,
                                CovarianceBlocks* blocks) {
   ceres::Problem* ceres_problem = problem->problem();
-  int t = 0;
-  const std::vector<double*> columns = LandmarksLast(problem, &t);
-  std::map<const double*, int> offset;
-  int at = 0;
-  for (double* block : columns) {
-    if (ceres_problem->IsParameterBlockConstant(block)) return false;
-    offset[block] = at;
-    at += ceres_problem->ParameterBlockSize(block);
-  }
-  std::vector<ceres::ResidualBlockId> ids;
-  ceres_problem->GetResidualBlocks(&ids);
-  double cost = 0.0;
-  Eigen::VectorXd residuals;
-  RowMajorSparse jacobian;
-  std::string why_not;
-  if (!Linearize(ceres_problem, ids, &cost, &residuals, &jacobian, &why_not,
-                 columns)) {
-    return false;
-  }
+  LinearizedProblem linearized;
+  if (!LinearizeLandmarksLast(problem, &linearized)) return false;
+  const std::map<const double*, int>& offset = linearized.offsets;
   const Eigen::SparseMatrix<double> information =
-      jacobian.transpose() * jacobian;
+      linearized.jacobian.transpose() * linearized.jacobian;
   SelectedInverse inverse;
   if (!inverse.Compute(information, kMaxSelectedInverseNonzeros)) return false;
   auto fill = [&](const double* a, const double* b, Eigen::MatrixXd* block) {
