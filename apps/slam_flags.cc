@@ -260,4 +260,11 @@ SlamOptions SlamOptionsFromFlags() {
   return options;
 }
 
+bool IsSlamFlag(const std::string& name) {
+  // gflags records the file that defines each flag.
+  gflags::CommandLineFlagInfo info;
+  return gflags::GetCommandLineFlagInfo(name.c_str(), &info) &&
+         info.filename == __FILE__;
+}
+
 }  // namespace rff

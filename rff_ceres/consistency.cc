@@ -16,8 +16,8 @@ namespace {
 constexpr std::array<double, 3> kChi2Quantile2 = {2.2958, 5.9915, 9.2103};
 constexpr std::array<double, 3> kChi2Quantile1 = {1.0, 3.8415, 6.6349};
 
-// The covariance at t, linear between the entries around it (a convex
-// combination of covariances is one).
+}  // namespace
+
 Eigen::Matrix3d CovarianceAt(const std::vector<PoseCovariance>& covariances,
                              double t) {
   const auto upper = std::lower_bound(
@@ -29,8 +29,6 @@ Eigen::Matrix3d CovarianceAt(const std::vector<PoseCovariance>& covariances,
   const double alpha = (t - lower->t) / (upper->t - lower->t);
   return (1.0 - alpha) * lower->covariance + alpha * upper->covariance;
 }
-
-}  // namespace
 
 bool EvaluateConsistency(const std::vector<TimedPose>& ground_truth,
                          const std::vector<TimedPose>& estimate,

@@ -7,11 +7,18 @@
 #include <string>
 #include <vector>
 
+#include "Eigen/Core"
 #include "rff_ceres/io/pose_covariance_io.h"
 #include "rff_ceres/metrics.h"
 #include "rff_ceres/types.h"
 
 namespace rff {
+
+// The covariance at t, linear between the entries around it (a convex
+// combination of covariances is one); an entry's own at its time, the end
+// entry's outside their span. `covariances` is sorted by time, not empty.
+Eigen::Matrix3d CovarianceAt(const std::vector<PoseCovariance>& covariances,
+                             double t);
 
 // Fills evaluation->consistency from `covariances`, given at the times of
 // `estimate` (as rff_slam writes them): at each ground-truth time, the

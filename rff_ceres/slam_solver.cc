@@ -7,6 +7,7 @@
 #include <initializer_list>
 #include <limits>
 #include <set>
+#include <utility>
 
 #include "ceres/types.h"
 #include "glog/logging.h"
@@ -57,6 +58,20 @@ class ProgressLogger : public ceres::IterationCallback {
 constexpr char kPreconditioners[] =
     "auto, IDENTITY, JACOBI, SCHUR_JACOBI, CLUSTER_JACOBI or "
     "CLUSTER_TRIDIAGONAL";
+
+// Stops the solve when the caller's SolverOptions::should_abort says so.
+class AbortCheck : public ceres::IterationCallback {
+ public:
+  explicit AbortCheck(std::function<bool()> should_abort)
+      : should_abort_(std::move(should_abort)) {}
+  ceres::CallbackReturnType operator()(
+      const ceres::IterationSummary&) override {
+    return should_abort_() ? ceres::SOLVER_ABORT : ceres::SOLVER_CONTINUE;
+  }
+
+ private:
+  std::function<bool()> should_abort_;
+};
 
 }  // namespace
 
@@ -911,6 +926,10 @@ bool RunSlamAtOrigin(const Dataset& dataset, const SlamOptions& options,
 
   ProgressLogger progress;
   if (options.solver.log_progress) ceres_options.callbacks.push_back(&progress);
+  AbortCheck abort_check(options.solver.should_abort);
+  if (options.solver.should_abort) {
+    ceres_options.callbacks.push_back(&abort_check);
+  }
   std::unique_ptr<SlamProblem> problem;
   if (incremental.every > 0) {
     if (!SolveIncremental(dataset, settled, ceres_options, model.get(),

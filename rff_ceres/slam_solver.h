@@ -5,6 +5,7 @@
 #ifndef RFF_CERES_SLAM_SOLVER_H_
 #define RFF_CERES_SLAM_SOLVER_H_
 
+#include <functional>
 #include <map>
 #include <memory>
 #include <ostream>
@@ -38,6 +39,10 @@ struct SolverOptions {
   double gradient_tolerance = 1e-10;
   double parameter_tolerance = 1e-8;
   bool log_progress = false;  // Ceres's per-iteration log (glog INFO).
+  // Asked before every Ceres iteration when set: true stops the solve, which
+  // then fails ("the solve failed: ..."). For a caller that is interrupted
+  // (a Python Ctrl-C) and cannot wait for the last iteration.
+  std::function<bool()> should_abort;
   // Largest linear system a solve may form (GB; 0: half of the machine's
   // memory): a larger one is refused before it is allocated.
   double max_memory_gb = 0.0;

@@ -8,6 +8,7 @@ PACKAGES=(
   build-essential cmake
   libceres-dev libeigen3-dev libgflags-dev libgoogle-glog-dev
   libgtest-dev libgmock-dev libbenchmark-dev
+  pybind11-dev python3-dev python3-numpy python3-pytest python3-matplotlib
 )
 
 missing=()

@@ -50,6 +50,18 @@ ConsistencySummary Consistency(const DrawnRun& run) {
   return evaluation.consistency;
 }
 
+TEST(CovarianceAtTest, ExactAtEntriesLinearBetweenEndsOutside) {
+  const Eigen::Matrix3d a = 0.3 * Eigen::Matrix3d::Identity();
+  Eigen::Matrix3d b;
+  b << 0.5, 0.1, 0.0, 0.1, 0.7, 0.02, 0.0, 0.02, 0.011;
+  const std::vector<PoseCovariance> covariances = {{1.0, a}, {3.0, b}};
+  EXPECT_EQ(CovarianceAt(covariances, 1.0), a);
+  EXPECT_EQ(CovarianceAt(covariances, 3.0), b);
+  EXPECT_TRUE(CovarianceAt(covariances, 1.5).isApprox(0.75 * a + 0.25 * b));
+  EXPECT_EQ(CovarianceAt(covariances, 0.0), a);
+  EXPECT_EQ(CovarianceAt(covariances, 9.0), b);
+}
+
 TEST(EvaluateConsistencyTest, ErrorsDrawnFromTheCovarianceAreConsistent) {
   const ConsistencySummary c = Consistency(Draw(20000, 1.0, 7));
   EXPECT_TRUE(c.evaluated);

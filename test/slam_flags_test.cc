@@ -89,5 +89,18 @@ TEST(SlamFlagsTest, DefaultFlagsGiveTheLibraryDefaults) {
   EXPECT_EQ(s.max_memory_gb, library.solver.max_memory_gb);
 }
 
+TEST(SlamFlagsTest, IsSlamFlagKnowsTheSolverFlagsOnly) {
+  for (const char* name :
+       {"prior", "num_features", "estimate_range_calibration", "max_memory_gb",
+        "parameter_tolerance"}) {
+    EXPECT_TRUE(IsSlamFlag(name)) << name;
+  }
+  // gflags's, glog's, a negated boolean and an unknown name.
+  for (const char* name : {"flagfile", "helpfull", "v", "logtostderr",
+                           "noestimate_range_calibration", "nonsense", ""}) {
+    EXPECT_FALSE(IsSlamFlag(name)) << name;
+  }
+}
+
 }  // namespace
 }  // namespace rff

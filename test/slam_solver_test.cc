@@ -542,6 +542,34 @@ TEST(SlamSolverTest, OverflowingResidualIsNamed) {
   EXPECT_THAT(error, HasSubstr("of landmark " + std::to_string(o.id)));
 }
 
+// A caller's abort (a Python Ctrl-C) stops the solve at the next iteration
+// and fails it; a solve never asked to stop is not changed by the check.
+TEST(SlamSolverTest, ShouldAbortStopsTheSolve) {
+  SimulationOptions sim = PaperOptions(19);
+  sim.num_steps = 40;
+  Dataset dataset;
+  std::string error;
+  ASSERT_TRUE(Simulate(sim, &dataset, &error)) << error;
+  SlamOptions options = PaperSolverOptions();
+  SlamResult plain;
+  ASSERT_TRUE(RunSlam(dataset, options, &plain, &error)) << error;
+
+  int asked = 0;
+  options.solver.should_abort = [&asked]() { return ++asked > 1000000; };
+  SlamResult checked;
+  ASSERT_TRUE(RunSlam(dataset, options, &checked, &error)) << error;
+  EXPECT_GT(asked, 0);
+  ASSERT_EQ(checked.trajectory.size(), plain.trajectory.size());
+  EXPECT_EQ(checked.trajectory.back().x, plain.trajectory.back().x);
+
+  asked = 0;
+  options.solver.should_abort = [&asked]() { return ++asked >= 2; };
+  SlamResult stopped;
+  EXPECT_FALSE(RunSlam(dataset, options, &stopped, &error));
+  EXPECT_THAT(error, HasSubstr("the solve failed"));
+  EXPECT_EQ(asked, 2);
+}
+
 TEST(SlamSolverTest, NothingToEstimateIsAnError) {
   Dataset dataset;
   dataset.pose_priors.push_back({{0.0, 0.0, 0.0, 0.0}, 0.1, 0.1});

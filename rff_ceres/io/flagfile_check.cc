@@ -45,6 +45,7 @@ std::string Trim(const std::string& text) {
 }
 
 bool CheckFlagfile(const std::string& path, const FlagIsKnown& is_known,
+                   const FlagLineVisitor& on_flag,
                    std::vector<std::string>* open, std::string* error) {
   std::error_code ec;
   const std::string canonical =
@@ -87,10 +88,14 @@ bool CheckFlagfile(const std::string& path, const FlagIsKnown& is_known,
     }
     if (name == "flagfile") {
       for (const std::string& nested : SplitCommas(FlagValue(text))) {
-        if (!CheckFlagfile(nested, is_known, open, error)) return false;
+        if (!CheckFlagfile(nested, is_known, on_flag, open, error)) {
+          return false;
+        }
       }
     } else if (!is_known(name)) {
       *error = where + "unknown flag '--" + name + "'";
+      return false;
+    } else if (on_flag && !on_flag(where, line, error)) {
       return false;
     }
   }
@@ -101,7 +106,8 @@ bool CheckFlagfile(const std::string& path, const FlagIsKnown& is_known,
 }  // namespace
 
 bool CheckFlagfiles(const std::vector<std::string>& args,
-                    const FlagIsKnown& is_known, std::string* error) {
+                    const FlagIsKnown& is_known, std::string* error,
+                    const FlagLineVisitor& on_flag) {
   for (std::size_t i = 0; i < args.size(); ++i) {
     if (args[i] == "--") break;
     if (FlagName(args[i]) != "flagfile") continue;
@@ -111,7 +117,7 @@ bool CheckFlagfiles(const std::vector<std::string>& args,
     }
     for (const std::string& path : SplitCommas(list)) {
       std::vector<std::string> open;
-      if (!CheckFlagfile(path, is_known, &open, error)) return false;
+      if (!CheckFlagfile(path, is_known, on_flag, &open, error)) return false;
     }
   }
   return true;

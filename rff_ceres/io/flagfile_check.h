@@ -15,12 +15,21 @@ namespace rff {
 // "name" both "name" and "noname" are known.
 using FlagIsKnown = std::function<bool(const std::string& name)>;
 
+// Given each flag line that passed the check, in the order gflags applies
+// them (a nested flagfile's lines where it is named): `where` is
+// "path:line: ", `line` the line as written, for gflags to parse. Returning
+// false stops the check with the error it set.
+using FlagLineVisitor = std::function<bool(
+    const std::string& where, const std::string& line, std::string* error)>;
+
 // Checks every flagfile named in `args` (--flagfile=A,B or --flagfile A)
 // and in the flagfiles they name: each can be read, none includes itself
 // directly or through others, and every line is blank, a '#' comment or
 // --name[=value] with a known name. `error` names the file and line.
+// `on_flag`, when given, sees every flag line as it is checked.
 bool CheckFlagfiles(const std::vector<std::string>& args,
-                    const FlagIsKnown& is_known, std::string* error);
+                    const FlagIsKnown& is_known, std::string* error,
+                    const FlagLineVisitor& on_flag = nullptr);
 
 }  // namespace rff
 

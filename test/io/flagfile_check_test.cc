@@ -63,6 +63,37 @@ TEST(FlagfileCheckTest, TheSameFileTwiceWithoutACycleIsFine) {
             "ok");
 }
 
+TEST(FlagfileCheckTest, TheVisitorSeesEveryFlagLineInGflagsOrder) {
+  const std::string dir = TempDir("FlagfileCheckTest");
+  WriteFile(dir + "/inner.flags", "--num_features=12\n");
+  WriteFile(dir + "/outer.flags", "# c\n  --prior=wnoa\n--flagfile=" + dir +
+                                      "/inner.flags\n--noevaluate\n");
+  std::vector<std::string> seen;
+  const FlagLineVisitor record =
+      [&seen](const std::string& where, const std::string& line, std::string*) {
+        seen.push_back(where + line);
+        return true;
+      };
+  std::string error;
+  ASSERT_TRUE(CheckFlagfiles({"--flagfile=" + dir + "/outer.flags"}, Known,
+                             &error, record))
+      << error;
+  EXPECT_EQ(seen,
+            (std::vector<std::string>{dir + "/outer.flags:2:   --prior=wnoa",
+                                      dir + "/inner.flags:1: --num_features=12",
+                                      dir + "/outer.flags:4: --noevaluate"}));
+
+  const FlagLineVisitor refuse = [](const std::string& where,
+                                    const std::string& line,
+                                    std::string* error) {
+    *error = where + "refused '" + line + "'";
+    return false;
+  };
+  EXPECT_FALSE(CheckFlagfiles({"--flagfile=" + dir + "/outer.flags"}, Known,
+                              &error, refuse));
+  EXPECT_EQ(error, dir + "/outer.flags:2: refused '  --prior=wnoa'");
+}
+
 TEST(FlagfileCheckTest, AMissingFileOrDirectoryIsAnError) {
   const std::string dir = TempDir("FlagfileCheckTest");
   EXPECT_EQ(Check({"--flagfile=" + dir + "/none.flags"}),
