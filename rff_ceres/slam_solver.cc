@@ -802,7 +802,8 @@ bool RunSlamAtOrigin(const Dataset& dataset, const SlamOptions& options,
   // as its initial value without odometry, where the localisation pilot
   // has no motion model to bridge gaps between fixes.
   SlamOptions warm = options;
-  ProblemOptions settled_losses = options.problem;
+  // The options as they settle: losses, learned scales and kernels.
+  SlamOptions settled = options;
   // A "wnoa" mean is an estimate: its covariance joins the correction's.
   SlamResult wnoa_mean_solve;
   const auto mean_start = std::chrono::steady_clock::now();
@@ -819,9 +820,9 @@ bool RunSlamAtOrigin(const Dataset& dataset, const SlamOptions& options,
     }
     // The same data: a loss the WNOA solve found no outlier for is dropped
     // here too. Its outliers may be its own misfit: the RFF solve decides.
-    if (wnoa.loss == "none") settled_losses.loss.name = "none";
+    if (wnoa.loss == "none") settled.problem.loss.name = "none";
     if (wnoa.odometry_loss == "none") {
-      settled_losses.odometry_loss.name = "none";
+      settled.problem.odometry_loss.name = "none";
     }
     if (wnoa_mean) {
       mean = std::make_shared<PiecewiseLinearMean>(wnoa.trajectory);
@@ -869,9 +870,6 @@ bool RunSlamAtOrigin(const Dataset& dataset, const SlamOptions& options,
     const Eigen::Vector3d pose = model->Pose(t);
     initial.push_back({t, pose.x(), pose.y(), pose.z()});
   }
-  SlamOptions settled = options;
-  settled.problem.loss = settled_losses.loss;
-  settled.problem.odometry_loss = settled_losses.odometry_loss;
   const bool search =
       options.learn_hyperparameters == "on" ||
       (options.learn_hyperparameters == "auto" && dataset.odometry.empty());
