@@ -5,6 +5,7 @@
 #include "apps/slam_flags.h"
 #include "gflags/gflags.h"
 #include "rff_ceres/io/flagfile_check.h"
+#include "rff_ceres/option_error.h"
 
 namespace rff {
 namespace {
@@ -88,8 +89,7 @@ bool SlamOptionsFromSettings(const std::vector<Setting>& settings,
     if (gflags::SetCommandLineOption(name.c_str(), value.c_str()).empty()) {
       gflags::CommandLineFlagInfo info;
       gflags::GetCommandLineFlagInfo(name.c_str(), &info);
-      *error = "illegal value '" + value + "' for option '" + name + "' (" +
-               info.type + ")";
+      *error = OptionError(name, value, "not a valid " + info.type + " value");
       return false;
     }
   }

@@ -61,13 +61,13 @@ def test_the_clis_file_flags_point_to_the_python_way(small, name, hint):
 
 
 @pytest.mark.parametrize("options,message", [
-    ({"num_features": "many"}, "illegal value 'many' for option "
-                               "'num_features' (int32)"),
-    ({"num_features": 1.5}, "illegal value '1.5' for option 'num_features'"),
-    ({"num_features": 2**40}, "for option 'num_features'"),
-    ({"lengthscale": "long"}, "illegal value 'long' for option 'lengthscale'"),
+    ({"num_features": "many"}, "--num_features=many: not a valid int32 "
+                               "value"),
+    ({"num_features": 1.5}, "--num_features=1.5: not a valid int32"),
+    ({"num_features": 2**40}, "--num_features=1099511627776: not a valid"),
+    ({"lengthscale": "long"}, "--lengthscale=long: not a valid double"),
     ({"estimate_range_calibration": "perhaps"},
-     "option 'estimate_range_calibration'"),
+     "--estimate_range_calibration=perhaps: not a valid bool"),
     ({"prior": "gp"}, "--prior=gp: unknown prior; allowed rff or wnoa"),
     ({"num_features": -3}, "num_features"),
     ({"lengthscale": [1.0]}, "option 'lengthscale' must be a bool, int, "
