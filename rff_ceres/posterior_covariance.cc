@@ -68,18 +68,20 @@ std::string SingularMessage(SlamProblem* problem,
 }
 
 // The Jacobian of every residual (through its loss) with the columns in
-// LandmarksLast's order, and each parameter block's first column.
+// LandmarksLast's order, each parameter block's first column, and the
+// number of columns before the landmarks'.
 struct LinearizedProblem {
   RowMajorSparse jacobian;
   std::map<const double*, int> offsets;
+  int num_leading = 0;
 };
 
 // False where a block is held constant or the problem cannot be evaluated
 // (ceres::Covariance evaluates it again and reports).
 bool LinearizeLandmarksLast(SlamProblem* problem, LinearizedProblem* out) {
   ceres::Problem* ceres_problem = problem->problem();
-  int t = 0;
-  const std::vector<double*> columns = LandmarksLast(problem, &t);
+  const std::vector<double*> columns =
+      LandmarksLast(problem, &out->num_leading);
   int at = 0;
   for (double* block : columns) {
     if (ceres_problem->IsParameterBlockConstant(block)) return false;
@@ -103,18 +105,15 @@ struct CovarianceBlocks {
 
 // The blocks from the Schur form of J^T J (gauss_newton_system.h), linear
 // in the landmarks. False, with nothing filled, where the problem has not
-// that form (sizes, a constant block, a residual on two landmarks, an
+// that form (sizes, a residual on two landmarks, an
 // ill-conditioned landmark) or J^T J is not positive definite.
 bool SchurCovariance(SlamProblem* problem, const TrajectoryModel& model,
+                     const LinearizedProblem& linearized,
                      const std::set<std::pair<int, int>>& block_pairs,
                      const std::vector<Landmark>& landmarks,
                      CovarianceBlocks* blocks) {
-  ceres::Problem* ceres_problem = problem->problem();
-  int t = 0;
-  LandmarksLast(problem, &t);
-  if (!SchurFormFits(t, ceres_problem->NumParameters() - t)) return false;
-  LinearizedProblem linearized;
-  if (!LinearizeLandmarksLast(problem, &linearized)) return false;
+  const int t = linearized.num_leading;
+  if (!SchurFormFits(t, linearized.jacobian.cols() - t)) return false;
   const std::map<const double*, int>& offset = linearized.offsets;
   // Not structured or not positive definite: the QR of J (Ceres) decides,
   // and names the landmarks the data leave free.
@@ -142,12 +141,11 @@ bool SchurCovariance(SlamProblem* problem, const TrajectoryModel& model,
 constexpr std::int64_t kMaxSelectedInverseNonzeros = std::int64_t{1} << 25;
 bool SelectedInverseCovariance(SlamProblem* problem,
                                const TrajectoryModel& model,
+                               const LinearizedProblem& linearized,
                                const std::set<std::pair<int, int>>& block_pairs,
                                const std::vector<Landmark>& landmarks,
                                CovarianceBlocks* blocks) {
   ceres::Problem* ceres_problem = problem->problem();
-  LinearizedProblem linearized;
-  if (!LinearizeLandmarksLast(problem, &linearized)) return false;
   const std::map<const double*, int>& offset = linearized.offsets;
   const Eigen::SparseMatrix<double> information =
       linearized.jacobian.transpose() * linearized.jacobian;
@@ -269,19 +267,22 @@ bool ComputePosteriorCovariance(SlamProblem* problem,
   if (requests.empty()) return true;
 
   CovarianceBlocks blocks;
-  CovarianceMethod used = CovarianceMethod::kSchur;
-  if (!options.use_schur ||
-      !SchurCovariance(problem, model, block_pairs, *landmarks, &blocks)) {
+  // One linearisation serves both exact methods.
+  LinearizedProblem linearized;
+  const bool exact = (options.use_schur || options.use_selected_inverse) &&
+                     LinearizeLandmarksLast(problem, &linearized);
+  CovarianceMethod used = CovarianceMethod::kCeres;
+  if (exact && options.use_schur &&
+      SchurCovariance(problem, model, linearized, block_pairs, *landmarks,
+                      &blocks)) {
+    used = CovarianceMethod::kSchur;
+  } else if (exact && options.use_selected_inverse &&
+             SelectedInverseCovariance(problem, model, linearized, block_pairs,
+                                       *landmarks, &blocks)) {
     used = CovarianceMethod::kSelectedInverse;
-    if (!options.use_selected_inverse ||
-        !SelectedInverseCovariance(problem, model, block_pairs, *landmarks,
-                                   &blocks)) {
-      used = CovarianceMethod::kCeres;
-      if (!CeresCovariance(problem, model, block_pairs, requests, *landmarks,
-                           options, &blocks, error)) {
-        return false;
-      }
-    }
+  } else if (!CeresCovariance(problem, model, block_pairs, requests, *landmarks,
+                              options, &blocks, error)) {
+    return false;
   }
   if (method != nullptr) *method = used;
   const auto& sigma = blocks.trajectory;
