@@ -97,9 +97,16 @@ def test_the_files_are_the_clis(both):
     for suffix, save, expected in files:
         path = directory / f"py.{suffix}"
         save(path)
-        np.testing.assert_allclose(np.loadtxt(path, ndmin=2),
-                                   np.loadtxt(expected, ndmin=2),
-                                   rtol=1e-12, atol=1e-15, err_msg=suffix)
+        actual = np.loadtxt(path, ndmin=2)
+        wanted = np.loadtxt(expected, ndmin=2)
+        tolerance = 1e-12 * np.abs(wanted) + 1e-15
+        if suffix == "cov":
+            # Rows are `t sxx sxy sxt syy syt stt`: a cross term left small
+            # by cancellation is held to 1e-10 of its pose's largest variance.
+            largest = np.abs(wanted[:, 1:]).max(axis=1, keepdims=True)
+            tolerance = np.maximum(tolerance, 1e-10 * largest)
+        np.testing.assert_array_less(np.abs(actual - wanted), tolerance,
+                                     err_msg=suffix)
 
 
 def test_the_arrays_are_the_clis_outputs(both):
