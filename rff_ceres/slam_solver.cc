@@ -618,6 +618,7 @@ bool InitializeBlocks(const Dataset& start, const SlamOptions& options,
 // them by their variance-component factors (variance_components.h,
 // MacKay's fixed point of the Laplace evidence) and solves again from the
 // current estimate, until every factor is within kScaleTolerance of one.
+constexpr double kJudgingTolerance = 1e-4;
 constexpr int kMaxScaleRounds = 6;
 constexpr double kScaleTolerance = 0.1;
 constexpr double kMaxScaleStep = 10.0;  // Per round, either way.
@@ -710,6 +711,22 @@ bool SettleAutoLosses(SlamProblem* problem, ProblemOptions* options) {
   settle(clean({"range", "bearing", "range-bearing"}), &options->loss);
   settle(clean({"odometry"}), &options->odometry_loss);
   return dropped;
+}
+
+bool HasAutoLoss(const ProblemOptions& options) {
+  return options.loss.name == "auto" || options.odometry_loss.name == "auto";
+}
+
+// The robust solve that judges "auto" losses stops at a relative cost change
+// of 1e-4, where residuals still move by hundredths of a sigma against an
+// outlier level of several; the solve after the judgement finishes it.
+ceres::Solver::Options JudgingOptions(const SlamOptions& options,
+                                      ceres::Solver::Options ceres_options) {
+  if (HasAutoLoss(options.problem)) {
+    ceres_options.function_tolerance =
+        std::max(ceres_options.function_tolerance, kJudgingTolerance);
+  }
+  return ceres_options;
 }
 
 // Adds the covariance of a mean that is itself an estimate (the WNOA
@@ -929,6 +946,7 @@ bool RunSlamAtOrigin(const Dataset& dataset, const SlamOptions& options,
     ceres_options.callbacks.push_back(&abort_check);
   }
   std::unique_ptr<SlamProblem> problem;
+  const bool judging = incremental.every == 0 && HasAutoLoss(settled.problem);
   if (incremental.every > 0) {
     if (!SolveIncremental(dataset, settled, ceres_options, model.get(),
                           &landmarks, &problem, result, error) ||
@@ -936,10 +954,11 @@ bool RunSlamAtOrigin(const Dataset& dataset, const SlamOptions& options,
                            error)) {
       return false;
     }
-  } else if (!SolveBatch(dataset, settled, ceres_options, model.get(),
+  } else if (!SolveBatch(dataset, settled,
+                         JudgingOptions(settled, ceres_options), model.get(),
                          &landmarks, initial_extent, &problem, result, error)) {
     return false;
-  } else if (SettleAutoLosses(problem.get(), &settled.problem) &&
+  } else if ((SettleAutoLosses(problem.get(), &settled.problem) || judging) &&
              !SolveBatch(dataset, settled, ceres_options, model.get(),
                          &landmarks, initial_extent, &problem, result, error)) {
     return false;
