@@ -9,10 +9,12 @@ DEFINE_string(prior, "rff",
               "the gpslam baseline).");
 DEFINE_string(prior_mean, "auto",
               "Prior mean: auto, odometry, wnoa, localization, spline or "
-              "constant. auto: with ODOM records, for the RFF prior in batch "
-              "mode wnoa (the WNOA posterior mean, which RFF then corrects), "
-              "else odometry (dead reckoning, allowed to turn about its "
-              "start); without, constant.");
+              "constant. auto: with ODOM records in batch mode, wnoa for the "
+              "RFF prior (the WNOA posterior mean, which RFF then corrects) "
+              "and constant for WNOA (started from dead reckoning, the "
+              "odometry counted once); incremental, odometry (dead "
+              "reckoning, allowed to turn about its start); without ODOM "
+              "records, constant.");
 DEFINE_string(initial_trajectory, "auto",
               "Initial value of the trajectory: auto (fit to a localisation "
               "against the landmark priors when one can be built, else the "

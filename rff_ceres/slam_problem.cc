@@ -216,23 +216,23 @@ void SlamProblem::AddOdometry(const PreintegratedOdometry& o) {
            {"odometry", o.t0, o.t1});
 }
 
-bool SlamProblem::OdometryResiduals(
-    const Dataset& dataset, std::vector<PreintegratedOdometry>* residuals,
-    std::string* error) const {
-  residuals->clear();
-  if (!options_.use_odometry) return true;
+bool OdometryChains(const Dataset& dataset, const ProblemOptions& options,
+                    std::vector<PreintegratedOdometry>* chains,
+                    std::string* error) {
+  chains->clear();
+  if (!options.use_odometry) return true;
   // Chains end at every time a pose is needed; without preintegration,
   // at every record (each record is a chain of its own).
   std::vector<double> keep_times;
   for (const Observation& o : dataset.observations) keep_times.push_back(o.t);
   for (const PosePrior& p : dataset.pose_priors) keep_times.push_back(p.pose.t);
-  if (!options_.preintegrate_odometry) {
+  if (!options.preintegrate_odometry) {
     for (const Odometry& o : dataset.odometry) keep_times.push_back(o.t0);
   }
   std::sort(keep_times.begin(), keep_times.end());
-  *residuals = PreintegrateOdometry(dataset.odometry, keep_times,
-                                    options_.max_preintegration_seconds);
-  for (const PreintegratedOdometry& o : *residuals) {
+  *chains = PreintegrateOdometry(dataset.odometry, keep_times,
+                                 options.max_preintegration_seconds);
+  for (const PreintegratedOdometry& o : *chains) {
     if (!SqrtInformation(o.covariance).allFinite()) {
       *error = "odometry from t = " + FormatNumber(o.t0) + " to " +
                FormatNumber(o.t1) +
@@ -262,7 +262,7 @@ bool SlamProblem::Build(const Dataset& dataset,
   for (const PosePrior& p : dataset.pose_priors) AddPosePrior(p);
   for (const LandmarkPrior& p : dataset.landmark_priors) AddLandmarkPrior(p);
   std::vector<PreintegratedOdometry> odometry;
-  if (!OdometryResiduals(dataset, &odometry, error)) return false;
+  if (!OdometryChains(dataset, options_, &odometry, error)) return false;
   for (const PreintegratedOdometry& o : odometry) AddOdometry(o);
   for (const Observation& o : dataset.observations) AddObservation(o);
   return true;

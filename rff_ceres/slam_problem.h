@@ -108,6 +108,13 @@ struct ProblemOptions {
   double max_preintegration_seconds = 1.0;
 };
 
+// The odometry residuals of `dataset` under `options` (composed chains
+// ending at every observation and prior time, or one per record); none
+// without use_odometry. Fails when a covariance cannot be inverted.
+bool OdometryChains(const Dataset& dataset, const ProblemOptions& options,
+                    std::vector<PreintegratedOdometry>* chains,
+                    std::string* error);
+
 // Fails naming the flag of a calibration prior sigma that is not finite and
 // positive (checked whether or not the calibration is estimated).
 bool CheckCalibrationOptions(const ProblemOptions& options, std::string* error);
@@ -143,12 +150,6 @@ class SlamProblem {
   void AddPosePrior(const PosePrior& prior);
   void AddOdometry(const PreintegratedOdometry& odometry);
   void AddObservation(const Observation& observation);
-  // The odometry residuals of `dataset` under the options (composed chains
-  // ending at every observation and prior time, or one per record); fails
-  // when a covariance cannot be inverted.
-  bool OdometryResiduals(const Dataset& dataset,
-                         std::vector<PreintegratedOdometry>* residuals,
-                         std::string* error) const;
 
   ceres::Problem* problem() { return problem_.get(); }
   // (scale, offset) of the range sensor: (1, 0) unless estimated. Set it

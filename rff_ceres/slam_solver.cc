@@ -183,9 +183,21 @@ std::unique_ptr<TrajectoryModel> CreateTrajectoryModel(
                                       error);
   } else if (options.prior == "wnoa") {
     // A state at every distinct observation time, and at both ends of the
-    // run so that no query extrapolates.
+    // run so that no query extrapolates. A mean other than dead reckoning
+    // leaves the motion to the states: one at each end of every odometry
+    // residual too, or the cubic between states could not follow it (a 64 s
+    // stretch without observations is one cubic).
     std::vector<double> times = {t_begin, t_end};
     for (const Observation& o : dataset.observations) times.push_back(o.t);
+    std::vector<PreintegratedOdometry> chains;
+    if (SettlePriorMean(options, dataset) != "odometry" &&
+        !OdometryChains(dataset, options.problem, &chains, error)) {
+      return nullptr;
+    }
+    for (const PreintegratedOdometry& chain : chains) {
+      times.push_back(chain.t0);
+      times.push_back(chain.t1);
+    }
     model = WnoaTrajectory::Create(options.wnoa, mean, std::move(times), error);
   } else {
     *error =
@@ -413,7 +425,9 @@ bool SolveIncremental(const Dataset& dataset, const SlamOptions& options,
     slam.AddLandmarkPrior(p);
   }
   std::vector<PreintegratedOdometry> odometry;
-  if (!slam.OdometryResiduals(dataset, &odometry, error)) return false;
+  if (!OdometryChains(dataset, options.problem, &odometry, error)) {
+    return false;
+  }
   std::size_t next_odometry = 0, next_prior = 0;
   int prior_end = 0;  // Trajectory prior terms added for blocks below this.
   std::vector<Observation> pending;  // Of landmarks not located yet.
@@ -587,8 +601,9 @@ SolveFacts SolveFactsOf(const SlamOptions& options, const SlamResult& result) {
   return facts;
 }
 
-// The blocks start at the fit of the pilot trajectory when there is one
-// (initial_trajectory "auto"), else at zero (the prior mean). A "wnoa" mean
+// The blocks start (initial_trajectory "auto") at dead reckoning about a
+// constant mean with odometry, else at the fit of the pilot
+// trajectory when there is one, else at zero (the prior mean). A "wnoa" mean
 // is already a solve of the data: it is the start.
 bool InitializeBlocks(const Dataset& start, const SlamOptions& options,
                       TrajectoryModel* model, SlamResult* result,
@@ -599,6 +614,20 @@ bool InitializeBlocks(const Dataset& start, const SlamOptions& options,
     return FitModelToPoses(options.initial_poses, model, error);
   }
   if (options.initial_trajectory == "mean" || result->prior_mean == "wnoa") {
+    return true;
+  }
+  if (result->prior_mean == "constant" && options.problem.use_odometry &&
+      !start.odometry.empty()) {
+    // Dead reckoning from the resolved start threads stretches without
+    // observations, where a localisation has nothing to go on.
+    DeadReckoningResult dead_reckoning;
+    DeadReckoningOptions through_gaps;
+    through_gaps.hold_through_gaps = true;
+    if (!DeadReckon(start, through_gaps, &dead_reckoning, error) ||
+        !FitModelToPoses(dead_reckoning.poses, model, error)) {
+      return false;
+    }
+    result->initial_trajectory = "dead reckoning";
     return true;
   }
   std::vector<TimedPose> pilot;
@@ -618,7 +647,6 @@ bool InitializeBlocks(const Dataset& start, const SlamOptions& options,
 // them by their variance-component factors (variance_components.h,
 // MacKay's fixed point of the Laplace evidence) and solves again from the
 // current estimate, until every factor is within kScaleTolerance of one.
-constexpr double kJudgingTolerance = 1e-4;
 constexpr int kMaxScaleRounds = 6;
 constexpr double kScaleTolerance = 0.1;
 constexpr double kMaxScaleStep = 10.0;  // Per round, either way.
@@ -713,6 +741,8 @@ bool SettleAutoLosses(SlamProblem* problem, ProblemOptions* options) {
   return dropped;
 }
 
+constexpr double kJudgingTolerance = 1e-4;
+
 bool HasAutoLoss(const ProblemOptions& options) {
   return options.loss.name == "auto" || options.odometry_loss.name == "auto";
 }
@@ -764,7 +794,8 @@ std::string SettlePriorMean(const SlamOptions& options,
   if (options.prior_mean != "auto") return options.prior_mean;
   if (dataset.odometry.empty()) return "constant";
   const bool batch = options.incremental.every == 0;
-  return options.prior == "rff" && batch ? "wnoa" : "odometry";
+  if (!batch) return "odometry";
+  return options.prior == "rff" ? "wnoa" : "constant";
 }
 
 namespace {

@@ -21,6 +21,48 @@ std::shared_ptr<const Eigen::VectorXd> RowPhi(int coordinate, double a,
   return phi;
 }
 
+// The velocities that minimise the WNOA energy sum_k e_k^T Q_k^-1 e_k of one
+// coordinate with its positions held (wnoa_prior_cost.h; q_c cancels): a
+// symmetric tridiagonal system, solved by elimination. Central differences
+// would disagree across states microseconds apart, where Q^-1 ~ dt^-3 turns
+// that into a prior cost of 10^5 and a solve that leaves its start.
+std::vector<double> SmoothestVelocities(const std::vector<double>& times,
+                                        const std::vector<double>& positions) {
+  const int n = static_cast<int>(times.size());
+  std::vector<double> diagonal(n, 0.0), upper(n, 0.0), rhs(n, 0.0);
+  for (int k = 0; k + 1 < n; ++k) {
+    const double dt = times[k + 1] - times[k];
+    const double d = positions[k + 1] - positions[k];
+    // e = (d - dt v_k, v_k+1 - v_k); Q^-1 = [12/dt^3 -6/dt^2; -6/dt^2 4/dt].
+    const double a = 12.0 / (dt * dt * dt), b = -6.0 / (dt * dt), c = 4.0 / dt;
+    // e = r0 + J (v_k, v_k+1) with r0 = (d, 0), J = [-dt 0; -1 1].
+    const Eigen::Matrix2d q_inverse =
+        (Eigen::Matrix2d() << a, b, b, c).finished();
+    const Eigen::Matrix2d jacobian =
+        (Eigen::Matrix2d() << -dt, 0.0, -1.0, 1.0).finished();
+    const Eigen::Matrix2d h = jacobian.transpose() * q_inverse * jacobian;
+    const Eigen::Vector2d g =
+        jacobian.transpose() * q_inverse * Eigen::Vector2d(d, 0.0);
+    diagonal[k] += h(0, 0);
+    diagonal[k + 1] += h(1, 1);
+    upper[k] += h(0, 1);
+    rhs[k] -= g(0);
+    rhs[k + 1] -= g(1);
+  }
+  std::vector<double> velocity(n, 0.0);
+  if (n < 2) return velocity;
+  for (int k = 1; k < n; ++k) {  // Forward elimination (the matrix is SPD).
+    const double factor = upper[k - 1] / diagonal[k - 1];
+    diagonal[k] -= factor * upper[k - 1];
+    rhs[k] -= factor * rhs[k - 1];
+  }
+  velocity[n - 1] = rhs[n - 1] / diagonal[n - 1];
+  for (int k = n - 2; k >= 0; --k) {
+    velocity[k] = (rhs[k] - upper[k] * velocity[k + 1]) / diagonal[k];
+  }
+  return velocity;
+}
+
 }  // namespace
 
 std::unique_ptr<WnoaTrajectory> WnoaTrajectory::Create(
@@ -104,16 +146,13 @@ void WnoaTrajectory::SetStatesFromPoses(const std::vector<TimedPose>& poses) {
                          WrapAngle(deviation[i].z() - deviation[i - 1].z());
     }
   }
-  for (int i = 0; i < n; ++i) {
-    const int before = std::max(i - 1, 0), after = std::min(i + 1, n - 1);
-    const double dt = times_[after] - times_[before];
-    const Eigen::Vector3d velocity =
-        dt > 0.0 ? Eigen::Vector3d((deviation[after] - deviation[before]) / dt)
-                 : Eigen::Vector3d::Zero();
-    double* state = mutable_block(i);
-    for (int c = 0; c < 3; ++c) {
-      state[c] = deviation[i][c];
-      state[3 + c] = velocity[c];
+  for (int c = 0; c < 3; ++c) {
+    std::vector<double> positions(n);
+    for (int i = 0; i < n; ++i) positions[i] = deviation[i][c];
+    const std::vector<double> velocity = SmoothestVelocities(times_, positions);
+    for (int i = 0; i < n; ++i) {
+      mutable_block(i)[c] = positions[i];
+      mutable_block(i)[3 + c] = velocity[i];
     }
   }
 }

@@ -84,9 +84,9 @@ class WnoaTrajectory : public TrajectoryModel {
   const std::vector<double>& state_times() const;
 
   // Sets every state to follow `poses` (sorted by time, at least one):
-  // positions from their linear interpolation minus the mean, velocities by
-  // central differences. The Markov states make this exact where a
-  // least-squares fit would need a solve of the whole trajectory.
+  // positions from their linear interpolation minus the mean, velocities the
+  // smoothest under the prior given those positions (one tridiagonal solve
+  // per coordinate).
   void SetStatesFromPoses(const std::vector<TimedPose>& poses);
 
   // The per-coordinate 2x2 interpolation matrices at `elapsed` = tau - t_i

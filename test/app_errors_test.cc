@@ -381,7 +381,7 @@ TEST(AppQualityTest, SuspectVerdictExitsThreeOnlyWhenAsked) {
   run = RunCommand(Expand(slam + "backwards.rffd", dir));
   EXPECT_EQ(run.exit_code, 3) << run.output;
   EXPECT_THAT(run.output,
-              HasSubstr("rff_slam: quality suspect: odometry chi2/n "));
+              HasSubstr("rff_slam: quality suspect: range-bearing chi2/n "));
   EXPECT_THAT(ReadFile(dir + "/out.json"),
               HasSubstr("\"quality\": \"suspect\""));
   EXPECT_TRUE(std::filesystem::exists(dir + "/out.tum"));

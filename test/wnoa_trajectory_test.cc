@@ -357,6 +357,42 @@ TEST(WnoaTrajectoryTest, PriorCostsOnConstantVelocityStates) {
   EXPECT_NEAR(cost, 2.25 + 0.5 * 4.0 / 0.5, 1e-9);
 }
 
+// States 10 us apart (an observation just after an odometry record) on a
+// circle of 10 m at 1 m/s: the prior cost of the fitted states is the
+// motion's own, 0.5 * integral |a|^2 / qc dt = 0.5 * 0.1^2 * 100 = 0.5.
+// Central differences would disagree by about a * 0.5 s across each pair,
+// costing 0.5 * (4 / 1e-5) * 0.05^2 = 500 per pair.
+TEST(WnoaTrajectoryTest, FitToPosesKeepsClosePairsSmooth) {
+  std::vector<double> times;
+  for (int k = 0; k <= 100; ++k) {
+    times.push_back(k);
+    if (k % 2 == 1) times.push_back(k + 1e-5);
+  }
+  WnoaOptions options;
+  options.initial_position_sigma = 1e3;
+  options.initial_heading_sigma = 1e3;
+  options.initial_velocity_sigma = 1e3;
+  options.initial_angular_velocity_sigma = 1e3;
+  auto model = MakeTrajectory(times, options);
+  ASSERT_NE(model, nullptr);
+  const LinearMean mean(times.front());
+  std::vector<TimedPose> poses;
+  for (double t = 0.0; t <= 100.0; t += 0.05) {
+    const Eigen::Vector3d p =
+        mean.Evaluate(t) + Eigen::Vector3d(10.0 * std::cos(0.1 * t),
+                                           10.0 * std::sin(0.1 * t), 0.1 * t);
+    poses.push_back({t, p.x(), p.y(), p.z()});
+  }
+  model->SetStatesFromPoses(poses);
+  ceres::Problem problem;
+  model->AddPriorCosts(&problem);
+  double cost = 0.0;
+  ASSERT_TRUE(problem.Evaluate(ceres::Problem::EvaluateOptions(), &cost,
+                               nullptr, nullptr, nullptr));
+  EXPECT_GT(cost, 0.4);
+  EXPECT_LT(cost, 0.6);
+}
+
 // Solves `dataset` with a WNOA trajectory (states at the observation and
 // ground-truth times, dead-reckoning mean) and returns the APE-trans RMS.
 double SolveWithWnoa(const Dataset& dataset, const WnoaOptions& options) {
