@@ -93,7 +93,7 @@ bool ParseRecord(const LineReader& reader,
   for (int k = 1; k <= layout.ids; ++k) {
     std::int64_t id;
     if (!ParseNonNegativeInt(fields[k], &id)) {
-      *error = reader.Error("field " + std::to_string(k) + " '" +
+      *error = reader.Error("field " + std::to_string(k + 1) + " '" +
                             std::string(fields[k].substr(0, 64)) +
                             "' is not a vertex id (a non-negative integer)");
       return false;
@@ -434,7 +434,8 @@ bool WriteG2o(const Dataset& input, std::ostream* output,
       }
       const Eigen::Matrix2d information = p.covariance.inverse();
       edges << "EDGE_SE2_XY " << ids
-            << JoinNumbers({p.x, p.y, information(0, 0), information(0, 1),
+            << JoinNumbers({p.x, p.y, information(0, 0),
+                            information(0, 1) + 0.0,  // Never "-0".
                             information(1, 1)})
             << "\n";
       if (placed.insert(o.id).second) {

@@ -242,11 +242,12 @@ class PyfgReader {
     return true;
   }
 
-  bool Isotropic(const Record& r, const std::vector<double>& sigmas) {
-    if (sigmas[0] == sigmas[1]) return true;
+  // The x and y variances of the n x n covariance at `first` are equal.
+  bool Isotropic(const Record& r, std::size_t first, int n) {
+    const double x = r.numbers[first], y = r.numbers[first + n];
+    if (x == y) return true;
     return Fail(r.line, r.type + " x and y variances differ (" +
-                            FormatNumber(sigmas[0] * sigmas[0]) + ", " +
-                            FormatNumber(sigmas[1] * sigmas[1]) +
+                            FormatNumber(x) + ", " + FormatNumber(y) +
                             "; .rffd priors have one position sigma)");
   }
 
@@ -263,7 +264,7 @@ class PyfgReader {
     if (r.type == "VERTEX_XY:PRIOR") {
       std::vector<double> s;
       if (!Defined(r, r.names[0], true) || !Sigmas(r, 2, 2, &s) ||
-          !Isotropic(r, s)) {
+          !Isotropic(r, 2, 2)) {
         return false;
       }
       if (!landmark_priors_.insert(r.names[0].number).second) {
@@ -285,18 +286,17 @@ class PyfgReader {
     if (r.type == "VERTEX_SE2:PRIOR") {
       if (!IsRobot(r.names[0])) return Other();
       std::vector<double> s;
-      if (!Sigmas(r, 3, 3, &s) || !Isotropic(r, s)) return false;
+      if (!Sigmas(r, 3, 3, &s) || !Isotropic(r, 3, 3)) return false;
       priors_.push_back({r.names[0].number, v[0], v[1], v[2], s});
       return true;
     }
     const bool to_landmark = r.type == "EDGE_SE2_XY" ||
                              (r.type == "EDGE_RANGE" && r.names[1].landmark());
     if (!Defined(r, r.names[1], to_landmark)) return false;
-    if (!IsRobot(r.names[0]) && (to_landmark || !IsRobot(r.names[1]))) {
-      const bool inter = !to_landmark && IsRobot(r.names[1]);
-      return inter ? Inter() : Other();
-    }
-    if (!to_landmark && !IsRobot(r.names[1])) return Inter();
+    const bool first = IsRobot(r.names[0]);
+    const bool second = !to_landmark && IsRobot(r.names[1]);
+    if (!to_landmark && first != second) return Inter();
+    if (!first) return Other();
     edges_.push_back(&r);
     return true;
   }
@@ -555,8 +555,9 @@ bool WritePyfg(const Dataset& dataset, std::ostream* output,
         return false;
       }
       const Eigen::Matrix2d& c = p.covariance;
+      // + 0: a cross term of -0 is written as 0.
       out << "EDGE_SE2_XY" << edge
-          << JoinNumbers({p.x, p.y, c(0, 0), c(0, 1), c(1, 1)}) << "\n";
+          << JoinNumbers({p.x, p.y, c(0, 0), c(0, 1) + 0.0, c(1, 1)}) << "\n";
     } else {
       ++summary->bearings_left_out;
     }
