@@ -1,29 +1,47 @@
-// rff_convert: converts a raw public dataset to .rffd (docs/converters.md).
+// rff_convert: converts a raw public dataset to .rffd, and .rffd to and from
+// the pose-graph formats PyFG and g2o (docs/converters.md).
 //
 //   rff_convert --format=plaza --input=DIR --output=OUT.rffd
 //       [--plaza_calibration=linear|none] [--plaza_heading_offset=auto|RAD]
 //   rff_convert --format=mrclam --input=DIR --mrclam_robot=N --output=OUT.rffd
 //       [--mrclam_odometry_interval=SECONDS]
+//   rff_convert --format=pyfg|g2o --input=FILE --output=OUT.rffd
+//       [--robot=A] [--rate=HZ]
+//   rff_convert --to=pyfg|g2o --input=IN.rffd --output=OUT
 #include <gflags/gflags.h>
 
 #include <cstdio>
 #include <map>
 #include <string>
 
+#include "rff_ceres/convert/g2o.h"
 #include "rff_ceres/convert/mrclam.h"
 #include "rff_ceres/convert/plaza.h"
+#include "rff_ceres/convert/pyfg.h"
 #include "rff_ceres/io/dataset_io.h"
 #include "rff_ceres/io/output_file.h"
 #include "rff_ceres/io/text_parser.h"
 #include "rff_ceres/option_error.h"
 #include "tool_flags.h"
 
-DEFINE_string(format, "", "Raw layout of --input: plaza or mrclam");
-DEFINE_string(input, "", "Directory with the raw dataset files");
-DEFINE_string(output, "", "The .rffd file to write");
+DEFINE_string(format, "",
+              "Format of --input: plaza or mrclam (a directory of raw "
+              "files), pyfg, g2o or rffd (a file); rffd when --to is pyfg or "
+              "g2o");
+DEFINE_string(to, "rffd", "Format of --output: rffd, pyfg or g2o");
+DEFINE_string(input, "", "Raw dataset directory, or the file to convert");
+DEFINE_string(output, "", "The file to write");
 DEFINE_double(prior_sigma_xy, -1.0,
               "PRIOR_POSE position sigma [m] (-1: format default, plaza "
-              "0.02, mrclam 0.01)");
+              "0.02, others 0.01); pyfg and g2o: only where the file has no "
+              "pose prior");
+DEFINE_string(robot, "",
+              "pyfg: the robot to read (A, B, ...); required when the file "
+              "has several");
+DEFINE_double(rate, 0.0,
+              "pyfg and g2o: pose k (PyFG pose number, g2o k-th pose vertex "
+              "by id) is at k / rate seconds; 0: the file's timestamps "
+              "(g2o: '# t=' comments, else 1 s apart)");
 DEFINE_double(prior_sigma_theta, 0.01, "PRIOR_POSE heading sigma [rad]");
 
 DEFINE_string(plaza_name, "Plaza1", "File prefix: reads NAME_GT.txt, ...");
@@ -198,36 +216,153 @@ bool ConvertMrclam(rff::Dataset* dataset, std::string* error) {
   return true;
 }
 
+double PriorSigmaXy() {
+  return FLAGS_prior_sigma_xy != -1.0 ? FLAGS_prior_sigma_xy : 0.01;
+}
+
+bool ReadPyfgFile(rff::Dataset* dataset, std::string* error) {
+  rff::PyfgReadOptions options;
+  options.robot = FLAGS_robot;
+  options.rate = FLAGS_rate;
+  options.prior_sigma_xy = PriorSigmaXy();
+  options.prior_sigma_theta = FLAGS_prior_sigma_theta;
+  rff::PyfgReadSummary s;
+  if (!rff::ReadPyfg(FLAGS_input, options, dataset, &s, error)) return false;
+  std::printf(
+      "pyfg: %zu records; robot %s of %s; %zu records of other "
+      "robots only\n",
+      s.records, s.robot.c_str(), s.robots.c_str(), s.other_robot_records);
+  if (s.num_robots > 1) {
+    std::fprintf(stderr,
+                 "rff_convert: note: --robot=%s: left out %zu inter-robot "
+                 "edges (.rffd holds one robot)\n",
+                 s.robot.c_str(), s.inter_robot_edges);
+  }
+  if (s.prior_added) {
+    std::printf(
+        "no VERTEX_SE2:PRIOR for robot %s: PRIOR_POSE at its first "
+        "pose (sigma %g m, %g rad)\n",
+        s.robot.c_str(), options.prior_sigma_xy, options.prior_sigma_theta);
+  }
+  return true;
+}
+
+bool ReadG2oFile(rff::Dataset* dataset, std::string* error) {
+  rff::G2oReadOptions options;
+  options.rate = FLAGS_rate;
+  options.prior_sigma_xy = PriorSigmaXy();
+  options.prior_sigma_theta = FLAGS_prior_sigma_theta;
+  rff::G2oReadSummary s;
+  if (!rff::ReadG2o(FLAGS_input, options, dataset, &s, error)) return false;
+  std::printf("g2o: %zu pose vertices, %zu landmark vertices; times from %s\n",
+              s.pose_vertices, s.landmark_vertices, s.times.c_str());
+  if (s.priors_added > 0) {
+    std::printf(
+        "no EDGE_PRIOR_SE2: PRIOR_POSE at %zu fixed or first pose "
+        "vertices (sigma %g m, %g rad)\n",
+        s.priors_added, options.prior_sigma_xy, options.prior_sigma_theta);
+  }
+  return true;
+}
+
+void LeftOut(std::size_t count, const char* what) {
+  if (count == 0) return;
+  std::fprintf(stderr, "rff_convert: note: left out %zu %s\n", count, what);
+}
+
+bool WritePyfgFile(const rff::Dataset& dataset, std::string* error) {
+  rff::PyfgWriteSummary s;
+  if (!rff::WritePyfg(dataset, FLAGS_output, &s, error)) return false;
+  std::printf(
+      "pyfg: %zu pose vertices (values: %zu GT_POSE, %zu "
+      "interpolated GT_POSE, %zu dead reckoning), %zu landmark "
+      "vertices (%zu without GT_LANDMARK)\n",
+      s.pose_vertices, s.poses_from_truth, s.poses_interpolated,
+      s.poses_dead_reckoned, s.landmark_vertices, s.landmarks_without_truth);
+  LeftOut(s.bearings_left_out, "BEARING records (PyFG has no bearing edge)");
+  if (s.poses_without_odometry > 0) {
+    std::printf(
+        "%zu pose vertices at observation times between ODOM "
+        "endpoints have no EDGE_SE2\n",
+        s.poses_without_odometry);
+  }
+  return true;
+}
+
+bool WriteG2oFile(const rff::Dataset& dataset, std::string* error) {
+  rff::G2oWriteSummary s;
+  if (!rff::WriteG2o(dataset, FLAGS_output, &s, error)) return false;
+  std::printf(
+      "g2o: %zu pose vertices (dead reckoning), %zu landmark "
+      "vertices\n",
+      s.pose_vertices, s.landmark_vertices);
+  LeftOut(s.ranges_left_out, "RANGE records (g2o 2D has no range edge)");
+  LeftOut(s.landmark_priors_left_out,
+          "PRIOR_LANDMARK records (g2o 2D has no landmark prior)");
+  LeftOut(s.ground_truth_left_out,
+          "GT_POSE and GT_LANDMARK records (g2o has no ground truth)");
+  return true;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   gflags::SetUsageMessage(
-      "converts a raw dataset to .rffd\n"
+      "converts a raw dataset to .rffd, and .rffd to and from PyFG and g2o\n"
       "  rff_convert --format=plaza --input=DIR --output=OUT.rffd "
       "[--plaza_calibration=linear|none]\n"
       "  rff_convert --format=mrclam --input=DIR --mrclam_robot=N "
-      "--output=OUT.rffd [--mrclam_odometry_interval=SECONDS]");
+      "--output=OUT.rffd [--mrclam_odometry_interval=SECONDS]\n"
+      "  rff_convert --format=pyfg|g2o --input=FILE --output=OUT.rffd "
+      "[--robot=A] [--rate=HZ]\n"
+      "  rff_convert --to=pyfg|g2o --input=IN.rffd --output=OUT");
   std::string error;
   if (!rff::ParseToolFlags(&argc, &argv, &error)) return Fail(error);
-  if (FLAGS_input.empty()) return Fail("--input=DIR is required");
-  if (FLAGS_output.empty()) return Fail("--output=OUT.rffd is required");
+  if (FLAGS_to != "rffd" && FLAGS_to != "pyfg" && FLAGS_to != "g2o") {
+    return Fail(rff::OptionError("to", FLAGS_to, "unknown output format",
+                                 "rffd, pyfg or g2o"));
+  }
+  const std::string format =
+      FLAGS_format.empty() && FLAGS_to != "rffd" ? "rffd" : FLAGS_format;
+  const bool raw = format == "plaza" || format == "mrclam";
+  if (!raw && format != "pyfg" && format != "g2o" && format != "rffd") {
+    return Fail(rff::OptionError("format", FLAGS_format, "unknown format",
+                                 "plaza, mrclam, pyfg, g2o or rffd"));
+  }
+  if (FLAGS_input.empty()) {
+    return Fail(std::string("--input=") + (raw ? "DIR" : "FILE") +
+                " is required");
+  }
+  if (FLAGS_output.empty()) {
+    return Fail("--output=OUT." + FLAGS_to + " is required");
+  }
   if (!rff::CheckOutputPaths({{"--input", FLAGS_input}},
                              {{"--output", FLAGS_output}}, &error)) {
     return Fail(error);
   }
   rff::Dataset dataset;
   bool ok;
-  if (FLAGS_format == "plaza") {
+  if (format == "plaza") {
     ok = ConvertPlaza(&dataset, &error);
-  } else if (FLAGS_format == "mrclam") {
+  } else if (format == "mrclam") {
     ok = ConvertMrclam(&dataset, &error);
+  } else if (format == "pyfg") {
+    ok = ReadPyfgFile(&dataset, &error);
+  } else if (format == "g2o") {
+    ok = ReadG2oFile(&dataset, &error);
   } else {
-    return Fail(rff::OptionError("format", FLAGS_format, "unknown format",
-                                 "plaza or mrclam"));
+    ok = rff::ReadDataset(FLAGS_input, &dataset, &error);
   }
   if (!ok) return Fail(error);
-  if (!rff::WriteDataset(dataset, FLAGS_output, &error)) return Fail(error);
   PrintRecordCounts(dataset);
+  if (FLAGS_to == "pyfg") {
+    ok = WritePyfgFile(dataset, &error);
+  } else if (FLAGS_to == "g2o") {
+    ok = WriteG2oFile(dataset, &error);
+  } else {
+    ok = rff::WriteDataset(dataset, FLAGS_output, &error);
+  }
+  if (!ok) return Fail(error);
   std::printf("wrote %s\n", FLAGS_output.c_str());
   return 0;
 }

@@ -194,9 +194,41 @@ const AppCase kAppCases[] = {
     // rff_convert.
     {"ConvertUnknownFormat",
      "{bin}/rff_convert --format=kitti --input={dir} --output={dir}/o.rffd",
-     "rff_convert: error: --format=kitti: unknown format; allowed plaza or "
-     "mrclam\n",
+     "rff_convert: error: --format=kitti: unknown format; allowed plaza, "
+     "mrclam, pyfg, g2o or rffd\n",
      "{dir}/o.rffd"},
+    {"ConvertNoFormat",
+     "{bin}/rff_convert --input={dir}/valid.rffd --output={dir}/o.rffd",
+     "rff_convert: error: --format=: unknown format; allowed plaza, mrclam, "
+     "pyfg, g2o or rffd\n",
+     "{dir}/o.rffd"},
+    {"ConvertUnknownOutputFormat",
+     "{bin}/rff_convert --to=csv --input={dir}/valid.rffd --output={dir}/o",
+     "rff_convert: error: --to=csv: unknown output format; allowed rffd, "
+     "pyfg or g2o\n",
+     "{dir}/o"},
+    {"ConvertToPyfgOverTheInput",
+     "{bin}/rff_convert --to=pyfg --input={dir}/valid.rffd "
+     "--output={dir}/valid.rffd",
+     "rff_convert: error: --output={dir}/valid.rffd: the same file as the "
+     "input --input={dir}/valid.rffd, never overwritten; allowed another "
+     "path\n",
+     ""},
+    {"ConvertBadDatasetToG2o",
+     "{bin}/rff_convert --to=g2o --input={dir}/bad.rffd --output={dir}/o.g2o",
+     "rff_convert: error: {dir}/bad.rffd:3: RANGE needs 4 fields, got 3\n",
+     "{dir}/o.g2o"},
+    {"ConvertDatasetReadAsPyfg",
+     "{bin}/rff_convert --format=pyfg --input={dir}/valid.rffd "
+     "--output={dir}/o.rffd",
+     "rff_convert: error: {dir}/valid.rffd:2: unknown record 'RFFD' (2D PyFG "
+     "has VERTEX_SE2, VERTEX_XY, their :PRIOR, EDGE_SE2, EDGE_SE2_XY and "
+     "EDGE_RANGE)\n",
+     "{dir}/o.rffd"},
+    {"ConvertG2oNegativeRate",
+     "{bin}/rff_convert --format=g2o --input={dir}/valid.rffd --rate=-1 "
+     "--output={dir}/o.rffd",
+     "rff_convert: error: --rate=-1: allowed 0 or more\n", "{dir}/o.rffd"},
     {"ConvertNoInput", "{bin}/rff_convert --format=plaza --output={dir}/o.rffd",
      "rff_convert: error: --input=DIR is required", "{dir}/o.rffd"},
     {"ConvertNoOutput", "{bin}/rff_convert --format=plaza --input={dir}",
@@ -404,6 +436,48 @@ TEST(AppHostileFileTest, ConvertRawFileErrorNamesFileAndLineAndWritesNothing) {
   EXPECT_EQ(run.exit_code, 1) << run.output;
   EXPECT_THAT(run.output,
               HasSubstr(dir + "/Tiny_GT.txt:2: field 4 'nan' is not a finite"));
+  EXPECT_FALSE(std::filesystem::exists(dir + "/o.rffd"));
+}
+
+TEST(AppHostileFileTest, ConvertPyfgPicksOneRobotAndCountsInterRobotEdges) {
+  const std::string dir = testing::TempDir("app_errors_test");
+  WriteFile(dir + "/two.pyfg",
+            "VERTEX_SE2 0 A0 0 0 0\nVERTEX_SE2 1 A1 1 0 0\n"
+            "VERTEX_SE2 0 B0 0 5 0\nVERTEX_XY L0 3 3\n"
+            "EDGE_SE2 1 A0 A1 1 0 0 0.01 0 0 0.01 0 0.01\n"
+            "EDGE_RANGE 1 A1 B0 5 0.01\nEDGE_RANGE 1 A1 L0 3.6 0.01\n");
+  RunResult run = RunCommand(
+      Expand("{bin}/rff_convert --format=pyfg --input={dir}/two.pyfg "
+             "--output={dir}/a.rffd",
+             dir));
+  EXPECT_EQ(run.exit_code, 1) << run.output;
+  EXPECT_EQ(run.output, "rff_convert: error: --robot=: " + dir +
+                            "/two.pyfg has 2 robots: pick one; allowed A or "
+                            "B\n");
+  EXPECT_FALSE(std::filesystem::exists(dir + "/a.rffd"));
+  run = RunCommand(
+      Expand("{bin}/rff_convert --format=pyfg --robot=A --input={dir}/two.pyfg "
+             "--output={dir}/a.rffd",
+             dir));
+  EXPECT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_THAT(run.output,
+              HasSubstr("rff_convert: note: --robot=A: left out 1 "
+                        "inter-robot edges (.rffd holds one robot)\n"));
+  EXPECT_THAT(ReadFile(dir + "/a.rffd"), HasSubstr("RANGE 1 0 3.6 0.1\n"));
+}
+
+TEST(AppHostileFileTest, ConvertG2oErrorNamesFileAndLineAndWritesNothing) {
+  const std::string dir = testing::TempDir("app_errors_test");
+  WriteFile(dir + "/bad.g2o",
+            "VERTEX_SE2 0 0 0 0\r\nVERTEX_SE2 1 1 0 0\r\n"
+            "EDGE_SE2 0 1 1 0 0 1 0 0 1 0\r\n");
+  const RunResult run =
+      RunCommand(Expand("{bin}/rff_convert --format=g2o --input={dir}/bad.g2o "
+                        "--output={dir}/o.rffd",
+                        dir));
+  EXPECT_EQ(run.exit_code, 1) << run.output;
+  EXPECT_EQ(run.output, "rff_convert: error: " + dir +
+                            "/bad.g2o:3: EDGE_SE2 needs 11 fields, got 10\n");
   EXPECT_FALSE(std::filesystem::exists(dir + "/o.rffd"));
 }
 

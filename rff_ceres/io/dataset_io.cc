@@ -201,7 +201,8 @@ class DatasetParser {
   std::set<LandmarkId> truth_ids_;
 };
 
-// Turns the leading "# key: value" comments into metadata pairs.
+}  // namespace
+
 void ParseMetadata(const std::vector<std::string>& comments, Dataset* dataset) {
   for (const std::string& comment : comments) {
     const std::size_t colon = comment.find(':');
@@ -220,7 +221,24 @@ void ParseMetadata(const std::vector<std::string>& comments, Dataset* dataset) {
   }
 }
 
-}  // namespace
+void SortRecords(Dataset* dataset) {
+  std::stable_sort(
+      dataset->observations.begin(), dataset->observations.end(),
+      [](const Observation& a, const Observation& b) { return a.t < b.t; });
+  std::stable_sort(
+      dataset->odometry.begin(), dataset->odometry.end(),
+      [](const Odometry& a, const Odometry& b) { return a.t0 < b.t0; });
+  std::stable_sort(
+      dataset->ground_truth.begin(), dataset->ground_truth.end(),
+      [](const TimedPose& a, const TimedPose& b) { return a.t < b.t; });
+  std::sort(dataset->landmark_priors.begin(), dataset->landmark_priors.end(),
+            [](const LandmarkPrior& a, const LandmarkPrior& b) {
+              return a.id < b.id;
+            });
+  std::sort(dataset->ground_truth_landmarks.begin(),
+            dataset->ground_truth_landmarks.end(),
+            [](const Landmark& a, const Landmark& b) { return a.id < b.id; });
+}
 
 bool ParseDataset(std::istream* input, const std::string& source,
                   Dataset* dataset, std::string* error) {
@@ -247,17 +265,8 @@ bool ParseDataset(std::istream* input, const std::string& source,
   }
   ParseMetadata(reader.leading_comments(), dataset);
 
-  // Records may come in any order: sort them once here (stable, so equal
-  // times keep their file order).
-  std::stable_sort(
-      dataset->observations.begin(), dataset->observations.end(),
-      [](const Observation& a, const Observation& b) { return a.t < b.t; });
-  std::stable_sort(
-      dataset->odometry.begin(), dataset->odometry.end(),
-      [](const Odometry& a, const Odometry& b) { return a.t0 < b.t0; });
-  std::stable_sort(
-      dataset->ground_truth.begin(), dataset->ground_truth.end(),
-      [](const TimedPose& a, const TimedPose& b) { return a.t < b.t; });
+  // Records may come in any order: sort them once here.
+  SortRecords(dataset);
   for (std::size_t i = 1; i < dataset->ground_truth.size(); ++i) {
     if (dataset->ground_truth[i].t == dataset->ground_truth[i - 1].t) {
       *error = source + ": two GT_POSE records at time " +
@@ -265,13 +274,6 @@ bool ParseDataset(std::istream* input, const std::string& source,
       return false;
     }
   }
-  std::sort(dataset->landmark_priors.begin(), dataset->landmark_priors.end(),
-            [](const LandmarkPrior& a, const LandmarkPrior& b) {
-              return a.id < b.id;
-            });
-  std::sort(dataset->ground_truth_landmarks.begin(),
-            dataset->ground_truth_landmarks.end(),
-            [](const Landmark& a, const Landmark& b) { return a.id < b.id; });
   return true;
 }
 
