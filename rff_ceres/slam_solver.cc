@@ -183,14 +183,14 @@ std::unique_ptr<TrajectoryModel> CreateTrajectoryModel(
                                       error);
   } else if (options.prior == "wnoa") {
     // A state at every distinct observation time, and at both ends of the
-    // run so that no query extrapolates. A mean other than dead reckoning
-    // leaves the motion to the states: one at each end of every odometry
-    // residual too, or the cubic between states could not follow it (a 64 s
-    // stretch without observations is one cubic).
+    // run so that no query extrapolates. A constant mean leaves the motion
+    // to the states: one at each end of every odometry residual too, or the
+    // cubic between states could not follow it (a 64 s stretch without
+    // observations would be one cubic).
     std::vector<double> times = {t_begin, t_end};
     for (const Observation& o : dataset.observations) times.push_back(o.t);
     std::vector<PreintegratedOdometry> chains;
-    if (SettlePriorMean(options, dataset) != "odometry" &&
+    if (SettlePriorMean(options, dataset) == "constant" &&
         !OdometryChains(dataset, options.problem, &chains, error)) {
       return nullptr;
     }
