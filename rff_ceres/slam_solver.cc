@@ -602,9 +602,9 @@ SolveFacts SolveFactsOf(const SlamOptions& options, const SlamResult& result) {
 }
 
 // The blocks start (initial_trajectory "auto") at dead reckoning about a
-// constant mean with odometry, else at the fit of the pilot
-// trajectory when there is one, else at zero (the prior mean). A "wnoa" mean
-// is already a solve of the data: it is the start.
+// constant mean with odometry, else at the fit of the pilot trajectory when
+// there is one, else at zero (the prior mean). A "wnoa" mean is already a
+// solve of the data: it is the start.
 bool InitializeBlocks(const Dataset& start, const SlamOptions& options,
                       TrajectoryModel* model, SlamResult* result,
                       std::string* error) {

@@ -505,6 +505,15 @@ TEST(SlamSolverTest, AutoLossIsDroppedOnlyWhereNoResidualIsAnOutlier) {
   ASSERT_TRUE(RunSlam(one_outlier, options, &robust, &error)) << error;
   EXPECT_EQ(robust.loss, "cauchy");
   EXPECT_EQ(robust.odometry_loss, "none");
+  // Judged on a robust solve stopped early, then finished: the estimate of
+  // the settled losses from the start.
+  SlamOptions settled = options;
+  settled.problem.loss = {"cauchy", 2.0};
+  settled.problem.odometry_loss = {"none", 1.0};
+  SlamResult direct;
+  ASSERT_TRUE(RunSlam(one_outlier, settled, &direct, &error)) << error;
+  EXPECT_NEAR(ApeTranslation(one_outlier, robust),
+              ApeTranslation(one_outlier, direct), 1e-4);
 
   // One odometry record that slips 2 m and 0.2 rad (40 and 20 sigma): the
   // odometry loss stays.
