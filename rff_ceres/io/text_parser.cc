@@ -168,6 +168,15 @@ std::string JoinAlternatives(const std::vector<std::string>& names) {
   return joined;
 }
 
+std::string ReplaceAll(std::string text, const std::string& from,
+                       const std::string& to) {
+  for (std::size_t at = text.find(from); at != std::string::npos;
+       at = text.find(from, at + to.size())) {
+    text.replace(at, from.size(), to);
+  }
+  return text;
+}
+
 bool OpenForReading(const std::string& path, std::ifstream* stream,
                     std::string* error) {
   std::error_code ec;

@@ -88,6 +88,11 @@ bool OpenForReading(const std::string& path, std::ifstream* stream,
 // "a", "a or b", "a, b or c": the allowed values of an option, for messages.
 std::string JoinAlternatives(const std::vector<std::string>& names);
 
+// `text` with every occurrence of `from` (not empty) replaced by `to`, left
+// to right; a replacement is not searched again.
+std::string ReplaceAll(std::string text, const std::string& from,
+                       const std::string& to);
+
 }  // namespace rff
 
 #endif  // RFF_CERES_IO_TEXT_PARSER_H_
