@@ -73,7 +73,8 @@ DEFINE_string(learn_hyperparameters, "auto",
 DEFINE_uint64(seed, 1, "Seed of the random feature frequencies.");
 DEFINE_double(segment_length, 0.0,
               "Windowed weights: segment length in seconds (0: one global "
-              "feature map over the whole run). At most 100000 segments.");
+              "feature map over each stretch of data). At most 100000 "
+              "segments.");
 DEFINE_double(segment_overlap, 0.0,
               "Windowed weights: blend overlap between segments (seconds), "
               "less than --segment_length.");

@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
+#include <limits>
+#include <map>
 #include <string>
 #include <utility>
 
@@ -18,6 +21,8 @@ namespace {
 // over this many: correlations beyond ~4 lengthscales are below 1e-3 (rbf).
 constexpr double kSegmentLengthscales = 10.0;
 constexpr double kOverlapLengthscales = 4.0;
+// A stretch of data at one time still needs a window of positive length.
+constexpr double kShortestStretch = 1e-3;
 
 // D of one feature map of `kernel` over [begin, end] at `tolerance`.
 int AutoNumFeatures(const KernelOptions& kernel_options, double missed_sigma,
@@ -50,6 +55,23 @@ double SegmentCount(double segment_length, double duration) {
   return std::max(1.0, std::ceil(duration / segment_length - 1e-9));
 }
 
+// What the prior's size check and its message need of the stretches.
+struct StretchLayout {
+  double covered = 0.0;  // Seconds, summed over the stretches.
+  std::string what;      // "the run's 10 s", with the number of stretches.
+};
+
+StretchLayout Describe(const std::vector<double>& lengths) {
+  StretchLayout layout;
+  for (const double length : lengths) layout.covered += length;
+  layout.what = lengths.size() == 1 ? "the run's " : "the data's ";
+  layout.what += FormatNumber(layout.covered) + " s";
+  if (lengths.size() > 1) {
+    layout.what += " (in " + std::to_string(lengths.size()) + " stretches)";
+  }
+  return layout;
+}
+
 }  // namespace
 
 FeatureTrajectoryOptions AutoCapacity(const FeatureTrajectoryOptions& options,
@@ -75,9 +97,29 @@ FeatureTrajectoryOptions AutoCapacity(const FeatureTrajectoryOptions& options,
   return filled;
 }
 
+double LongestBridgedGap(const FeatureTrajectoryOptions& options) {
+  const double gap = std::max(
+      {options.segment_length, kShortestStretch,
+       kSegmentLengthscales * std::max(options.position_kernel.lengthscale,
+                                       options.heading_kernel.lengthscale)});
+  // Bad lengthscales (Create names them): one stretch, as without gaps.
+  return gap < std::numeric_limits<double>::infinity()
+             ? gap
+             : std::numeric_limits<double>::infinity();
+}
+
+std::unique_ptr<FeatureTrajectory> FeatureTrajectory::Create(
+    const FeatureTrajectoryOptions& options,
+    std::shared_ptr<const MeanFunction> mean, double t_begin, double t_end,
+    std::string* error) {
+  DataTimes times;
+  times.constraints.push_back({t_begin, t_end});
+  return Create(options, std::move(mean), times, error);
+}
+
 std::unique_ptr<FeatureTrajectory> FeatureTrajectory::Create(
     const FeatureTrajectoryOptions& requested,
-    std::shared_ptr<const MeanFunction> mean, double t_begin, double t_end,
+    std::shared_ptr<const MeanFunction> mean, const DataTimes& times,
     std::string* error) {
   for (const auto& [d, name] :
        {std::pair(requested.num_position_features, "num_features"),
@@ -119,33 +161,58 @@ std::unique_ptr<FeatureTrajectory> FeatureTrajectory::Create(
         "blends segments, but --segment_length=0 has none", "0 there");
     return nullptr;
   }
-  // A run with one time still needs a window of positive length.
-  const double length = std::max(t_end - t_begin, 1e-3);
+  const std::vector<TimeInterval> stretches =
+      DataStretches(times, LongestBridgedGap(requested));
+  std::vector<double> lengths;
+  for (const TimeInterval& stretch : stretches) {
+    lengths.push_back(std::max(stretch.end - stretch.begin, kShortestStretch));
+  }
+  const StretchLayout layout = Describe(lengths);
   if (requested.segment_length > 0.0 &&
-      !(length / requested.segment_length <= kMaxSegments)) {
+      !(layout.covered / requested.segment_length <= kMaxSegments)) {
     *error = OptionError(
         "segment_length", FormatNumber(requested.segment_length),
-        "cuts the run's " + FormatNumber(length) + " s into more than " +
+        "cuts " + layout.what + " into more than " +
             std::to_string(kMaxSegments) + " segments",
-        "0 or at least " + FormatNumber(length / kMaxSegments) +
+        "0 or at least " + FormatNumber(layout.covered / kMaxSegments) +
             " for this run");
     return nullptr;
   }
-  const FeatureTrajectoryOptions options = AutoCapacity(requested, length);
-  const double num_segments_needed =
-      SegmentCount(options.segment_length, length);
-  const double dp = options.num_position_features;
-  const double dh = options.num_heading_features;
-  const double weights_per_segment = 2.0 * dp * dp + dh * dh;
-  if (num_segments_needed * weights_per_segment > kMaxPriorNonZeros) {
-    const std::string why = "the run's " + FormatNumber(length) + " s need " +
-                            FormatNumber(num_segments_needed) +
-                            " segments of " + FormatNumber(dp) +
-                            " features (x, y) and " + FormatNumber(dh) +
-                            " (theta): more weights than memory allows";
+  // Each stretch settles its capacity as a run of its length would; many
+  // stretches of one length (lone observations) settle it once.
+  std::map<double, FeatureTrajectoryOptions> settled_by_length;
+  std::vector<const FeatureTrajectoryOptions*> settled;
+  double num_segments_needed = 0.0, prior_non_zeros = 0.0;
+  double widest_segment_weights = 0.0, dp = 0.0, dh = 0.0;
+  for (const double length : lengths) {
+    auto it = settled_by_length.find(length);
+    if (it == settled_by_length.end()) {
+      it = settled_by_length.emplace(length, AutoCapacity(requested, length))
+               .first;
+    }
+    const FeatureTrajectoryOptions& options = it->second;
+    settled.push_back(&options);
+    const double count = SegmentCount(options.segment_length, length);
+    const double features = options.num_position_features;
+    const double heading_features = options.num_heading_features;
+    const double weights =
+        2.0 * features * features + heading_features * heading_features;
+    num_segments_needed += count;
+    prior_non_zeros += count * weights;
+    if (weights > widest_segment_weights) {
+      widest_segment_weights = weights;
+      dp = features;
+      dh = heading_features;
+    }
+  }
+  if (prior_non_zeros > kMaxPriorNonZeros) {
+    const std::string why =
+        layout.what + " need " + FormatNumber(num_segments_needed) +
+        " segments of " + FormatNumber(dp) + " features (x, y) and " +
+        FormatNumber(dh) + " (theta): more weights than memory allows";
     // Fewer segments of these features, or as many of fewer features.
     const double shortest_segment =
-        length / std::floor(kMaxPriorNonZeros / weights_per_segment);
+        layout.covered / std::floor(kMaxPriorNonZeros / widest_segment_weights);
     if (requested.num_position_features == kAutoCapacity) {
       *error = OptionError(
           "segment_length", FormatNumber(requested.segment_length), why,
@@ -163,19 +230,39 @@ std::unique_ptr<FeatureTrajectory> FeatureTrajectory::Create(
     return nullptr;
   }
   std::unique_ptr<FeatureTrajectory> model(new FeatureTrajectory);
-  model->options_ = options;
+  const auto longest = std::max_element(lengths.begin(), lengths.end());
+  model->options_ = *settled[longest - lengths.begin()];
   model->mean_ = std::move(mean);
-  model->origin_ = t_begin;
-  model->position_kernel_ = CreateKernel(options.position_kernel, error);
+  model->reach_ =
+      kOverlapLengthscales * std::max(requested.position_kernel.lengthscale,
+                                      requested.heading_kernel.lengthscale);
+  model->position_kernel_ = CreateKernel(requested.position_kernel, error);
   if (!model->position_kernel_) return nullptr;
   model->heading_kernel_ =
-      CreateKernel(options.heading_kernel, error, "heading_");
+      CreateKernel(requested.heading_kernel, error, "heading_");
   if (!model->heading_kernel_) return nullptr;
+  for (std::size_t c = 0; c < stretches.size(); ++c) {
+    if (!model->AddStretch(*settled[c], stretches[c], lengths[c], error)) {
+      return nullptr;
+    }
+  }
+  model->weights_ = Eigen::VectorXd::Zero(model->offsets_.back());
+  return model;
+}
 
+bool FeatureTrajectory::AddStretch(const FeatureTrajectoryOptions& options,
+                                   const TimeInterval& data, double length,
+                                   std::string* error) {
+  Stretch stretch;
+  stretch.begin = data.begin;
+  stretch.end = std::max(data.end, data.begin + length);
+  stretch.first_segment = num_segments();
   // Bounded above by the prior's size check.
-  const int num_segments = static_cast<int>(num_segments_needed);
+  stretch.num_segments =
+      static_cast<int>(SegmentCount(options.segment_length, length));
+  const int num_segments = stretch.num_segments;
   const double segment = length / num_segments;
-  model->overlap_ = num_segments > 1 ? options.segment_overlap : 0.0;
+  stretch.overlap = num_segments > 1 ? options.segment_overlap : 0.0;
   for (int k = 0; k < num_segments; ++k) {
     Segment s;
     s.begin = k * segment;
@@ -184,54 +271,71 @@ std::unique_ptr<FeatureTrajectory> FeatureTrajectory::Create(
     map_options.family = options.family;
     map_options.num_features_flag = "num_features";
     // Each segment's maps cover its extent and half the overlap each side.
-    map_options.window_begin = k > 0 ? -0.5 * model->overlap_ : 0.0;
+    map_options.window_begin = k > 0 ? -0.5 * stretch.overlap : 0.0;
     map_options.window_end =
-        segment + (k + 1 < num_segments ? 0.5 * model->overlap_ : 0.0);
+        segment + (k + 1 < num_segments ? 0.5 * stretch.overlap : 0.0);
     map_options.num_features = options.num_position_features;
+    // The draws restart in each stretch: it solves as it would alone.
     map_options.seed = options.seed + 2 * k;
-    s.position_map =
-        CreateFeatureMap(*model->position_kernel_, map_options, error);
-    if (!s.position_map) return nullptr;
+    s.position_map = CreateFeatureMap(*position_kernel_, map_options, error);
+    if (!s.position_map) return false;
     map_options.num_features = options.num_heading_features;
     map_options.num_features_flag = "num_heading_features";
     map_options.seed = options.seed + 2 * k + 1;  // Independent draws.
-    s.heading_map =
-        CreateFeatureMap(*model->heading_kernel_, map_options, error);
-    if (!s.heading_map) return nullptr;
+    s.heading_map = CreateFeatureMap(*heading_kernel_, map_options, error);
+    if (!s.heading_map) return false;
     for (const int size :
          {s.position_map->num_features(), s.position_map->num_features(),
           s.heading_map->num_features()}) {
-      model->offsets_.push_back(model->offsets_.back() + size);
+      offsets_.push_back(offsets_.back() + size);
     }
-    model->segments_.push_back(std::move(s));
+    segments_.push_back(std::move(s));
   }
-  model->weights_ = Eigen::VectorXd::Zero(model->offsets_.back());
-  return model;
+  stretches_.push_back(stretch);
+  return true;
 }
 
 const std::vector<FeatureTrajectory::Features>& FeatureTrajectory::FeaturesAt(
     double t) const {
   auto it = cache_.find(t);
   if (it != cache_.end()) return it->second;
-  const double tau = t - origin_;
-  const int last = static_cast<int>(segments_.size()) - 1;
+  std::vector<Features> features;
+  // The stretch holding t, or the nearest within reach_ of its ends.
+  const auto after = std::upper_bound(
+      stretches_.begin(), stretches_.end(), t,
+      [](double time, const Stretch& s) { return time < s.begin; });
+  const Stretch* nearest = nullptr;
+  double distance = reach_;
+  if (after != stretches_.begin() &&
+      std::max(t - std::prev(after)->end, 0.0) <= distance) {
+    nearest = &*std::prev(after);
+    distance = std::max(t - nearest->end, 0.0);
+  }
+  if (after != stretches_.end() && after->begin - t < distance) {
+    nearest = &*after;
+  }
+  if (!nearest) return cache_.emplace(t, std::move(features)).first->second;
+  const Stretch& stretch = *nearest;
+  const double tau = t - stretch.begin;
+  const int first = stretch.first_segment;
+  const int last = first + stretch.num_segments - 1;
   // The segment whose nominal extent holds tau (clamped at the ends).
-  const double segment = segments_[0].end - segments_[0].begin;
-  const int k =
-      std::clamp(static_cast<int>(std::floor(tau / segment)), 0, last);
+  const double segment = segments_[first].end - segments_[first].begin;
+  const int k = first + std::clamp(static_cast<int>(std::floor(tau / segment)),
+                                   0, stretch.num_segments - 1);
   // (segment, blend weight) pairs active at tau.
   std::vector<std::pair<int, double>> active;
-  const double half = 0.5 * overlap_;
-  if (k > 0 && tau < segments_[k].begin + half) {
-    const double u = (tau - (segments_[k].begin - half)) / overlap_;
+  const double overlap = stretch.overlap;
+  const double half = 0.5 * overlap;
+  if (k > first && tau < segments_[k].begin + half) {
+    const double u = (tau - (segments_[k].begin - half)) / overlap;
     active = {{k - 1, std::cos(0.5 * M_PI * u)}, {k, std::sin(0.5 * M_PI * u)}};
   } else if (k < last && tau > segments_[k].end - half) {
-    const double u = (tau - (segments_[k].end - half)) / overlap_;
+    const double u = (tau - (segments_[k].end - half)) / overlap;
     active = {{k, std::cos(0.5 * M_PI * u)}, {k + 1, std::sin(0.5 * M_PI * u)}};
   } else {
     active = {{k, 1.0}};
   }
-  std::vector<Features> features;
   for (const auto& [s, weight] : active) {
     const Segment& seg = segments_[s];
     auto position =

@@ -4,8 +4,9 @@
 //
 // for k in {x, y, theta}. x and y share one kernel and feature map (with
 // their own weights); the heading has its own. Times are shifted to the
-// start of the run before the features see them: Unix-epoch seconds
-// (~1.2e9) would leave cos(w t) with no significant digits.
+// start of their stretch of data (below) before the features see them:
+// Unix-epoch seconds (~1.2e9) would leave cos(w t) with no significant
+// digits.
 //
 // Windowed weights: with a segment length S > 0 the run is cut into segments,
 // each with its own feature maps and weight blocks, blended across an
@@ -13,6 +14,10 @@
 // (u from 0 to 1 across the overlap). The squares of the blend weights sum to
 // one, so the prior variance k(0) is kept everywhere, and the reduced system
 // is block-banded: its cost grows linearly with the length of the run.
+//
+// Segments only where data is: the data's times are cut into stretches at
+// every gap longer than LongestBridgedGap, and each stretch is laid out as if
+// it were the whole run (its own origin, segments and capacity).
 #ifndef RFF_CERES_FEATURE_TRAJECTORY_H_
 #define RFF_CERES_FEATURE_TRAJECTORY_H_
 
@@ -22,6 +27,7 @@
 #include <string>
 #include <vector>
 
+#include "rff_ceres/data_stretches.h"
 #include "rff_ceres/features/feature_map.h"
 #include "rff_ceres/kernels/kernel.h"
 #include "rff_ceres/mean/mean_function.h"
@@ -69,13 +75,26 @@ inline constexpr double kMaxPriorNonZeros = 2e8;  // 1.6 GB of Jacobian.
 FeatureTrajectoryOptions AutoCapacity(const FeatureTrajectoryOptions& options,
                                       double duration);
 
+// The longest time without data that segments still span: a segment, and
+// kSegmentLengthscales lengthscales of either kernel (beyond which the prior
+// correlates nothing: exp(-50) for rbf).
+double LongestBridgedGap(const FeatureTrajectoryOptions& options);
+
 class FeatureTrajectory : public TrajectoryModel {
  public:
   // Blocks of segment s are 3 s + {kX, kY, kTheta}.
   enum Block { kX = 0, kY = 1, kTheta = 2 };
 
-  // The model on the time window [t_begin, t_end] around `mean`. Returns
-  // nullptr and sets `error` on bad options.
+  // The model around `mean` with segments over the stretches of `times`
+  // (DataStretches). A time more than kOverlapLengthscales lengthscales from
+  // every stretch has no segment: its pose is the prior mean, as the GP
+  // posterior's is that far from the data.
+  // Returns nullptr and sets `error` on bad options.
+  static std::unique_ptr<FeatureTrajectory> Create(
+      const FeatureTrajectoryOptions& options,
+      std::shared_ptr<const MeanFunction> mean, const DataTimes& times,
+      std::string* error);
+  // The model on the one stretch [t_begin, t_end].
   static std::unique_ptr<FeatureTrajectory> Create(
       const FeatureTrajectoryOptions& options,
       std::shared_ptr<const MeanFunction> mean, double t_begin, double t_end,
@@ -91,6 +110,7 @@ class FeatureTrajectory : public TrajectoryModel {
     return weights_.data() + offsets_[block];
   }
   int num_segments() const { return static_cast<int>(segments_.size()); }
+  int num_stretches() const { return static_cast<int>(stretches_.size()); }
   bool HasDenseReducedSystem() const override { return true; }
   PoseMap PoseAt(double t) const override;
   using TrajectoryModel::AddPriorCosts;
@@ -101,8 +121,8 @@ class FeatureTrajectory : public TrajectoryModel {
   std::vector<PriorScale> PriorRowScales(const std::vector<double*>& blocks,
                                          int num_rows) const override;
 
-  double origin() const { return origin_; }
-  // The options with the capacity settled (see AutoCapacity).
+  // The options with the capacity settled (see AutoCapacity), of the longest
+  // stretch where each settles its own.
   const FeatureTrajectoryOptions& options() const { return options_; }
   const MeanFunction& mean() const override { return *mean_; }
   void set_mean(std::shared_ptr<const MeanFunction> mean) override {
@@ -112,8 +132,20 @@ class FeatureTrajectory : public TrajectoryModel {
  private:
   FeatureTrajectory() = default;
 
+  // Data times close together, with segments numbered [first_segment,
+  // first_segment + num_segments) blended over `overlap`.
+  struct Stretch {
+    // Absolute times of the first and last datum. Features see times
+    // relative to `begin`, so a stretch gives the same features wherever it
+    // is in the run (and precision however late the clock).
+    double begin = 0.0;
+    double end = 0.0;
+    double overlap = 0.0;
+    int first_segment = 0;
+    int num_segments = 0;
+  };
   struct Segment {
-    double begin = 0.0;  // Nominal extent, relative to the origin.
+    double begin = 0.0;  // Nominal extent, relative to its stretch's begin.
     double end = 0.0;
     // Of times relative to `begin`: the feature maps keep their precision
     // however long the run.
@@ -126,13 +158,18 @@ class FeatureTrajectory : public TrajectoryModel {
     std::shared_ptr<const Eigen::VectorXd> heading;
   };
   const std::vector<Features>& FeaturesAt(double t) const;
+  // Appends the segments of one stretch of `data`, `length` seconds long.
+  bool AddStretch(const FeatureTrajectoryOptions& options,
+                  const TimeInterval& data, double length, std::string* error);
 
   FeatureTrajectoryOptions options_;
   std::shared_ptr<const MeanFunction> mean_;
   std::unique_ptr<Kernel> position_kernel_, heading_kernel_;
+  std::vector<Stretch> stretches_;  // In time order.
+  // How far past its stretch a segment is evaluated: the margin of the
+  // Hilbert domain. Farther from data the pose is the prior mean alone.
+  double reach_ = 0.0;
   std::vector<Segment> segments_;
-  double overlap_ = 0.0;
-  double origin_ = 0.0;
   // All blocks in one buffer, block b at offsets_[b]: Ceres orders the blocks
   // of an elimination group by address, so contiguous storage in block order
   // makes the solve's arithmetic (and its output) reproducible.

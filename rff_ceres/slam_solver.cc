@@ -11,6 +11,7 @@
 
 #include "ceres/types.h"
 #include "glog/logging.h"
+#include "rff_ceres/data_stretches.h"
 #include "rff_ceres/dead_reckoning.h"
 #include "rff_ceres/initialization.h"
 #include "rff_ceres/io/text_parser.h"
@@ -26,7 +27,7 @@
 namespace rff {
 namespace {
 
-// Every time the dataset mentions, for the extent of the feature window.
+// Every time the dataset mentions: the WNOA states reach both ends.
 void TimeSpan(const Dataset& dataset, double* begin, double* end) {
   std::vector<double> times = OutputTimes(dataset);
   for (const Odometry& o : dataset.odometry) {
@@ -179,8 +180,8 @@ std::unique_ptr<TrajectoryModel> CreateTrajectoryModel(
   TimeSpan(dataset, &t_begin, &t_end);
   std::unique_ptr<TrajectoryModel> model;
   if (options.prior == "rff") {
-    model = FeatureTrajectory::Create(options.trajectory, mean, t_begin, t_end,
-                                      error);
+    model = FeatureTrajectory::Create(options.trajectory, mean,
+                                      DataTimesOf(dataset), error);
   } else if (options.prior == "wnoa") {
     // A state at every distinct observation time, and at both ends of the
     // run so that no query extrapolates. A constant mean leaves the motion

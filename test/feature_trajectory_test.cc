@@ -148,5 +148,91 @@ TEST(FeatureTrajectoryTest, MoreWeightsThanMemoryAllowsFails) {
             "--segment_length of at least 1.5873015873015872");
 }
 
+// Options of the windowed-weight tests: 40 features per map, segments of
+// 20 s blended over 8 s, rbf lengthscales of 3 s (gaps over 30 s split).
+FeatureTrajectoryOptions WindowedOptions() {
+  FeatureTrajectoryOptions options =
+      Options({"rbf", 4.0, 3.0}, {"rbf", 0.3, 3.0}, 40);
+  options.segment_length = 20.0;
+  options.segment_overlap = 8.0;
+  return options;
+}
+
+int NumWeights(const FeatureTrajectory& model) {
+  int count = 0;
+  for (int b = 0; b < model.num_blocks(); ++b) count += model.block_size(b);
+  return count;
+}
+
+// Segments only where data is: two stretches of data 9e5 s apart get the
+// segments each gets alone and none over the gap, where the pose is the
+// prior mean. The later stretch has the features it has alone, bit for bit.
+TEST(FeatureTrajectoryTest, SegmentsOnlyWhereDataIs) {
+  const FeatureTrajectoryOptions options = WindowedOptions();
+  DataTimes times;
+  times.constraints = {{0.0, 100.0}, {9e5, 9e5 + 50.0}};
+  std::string error;
+  const auto model =
+      FeatureTrajectory::Create(options, ZeroMean(), times, &error);
+  ASSERT_TRUE(model) << error;
+  EXPECT_EQ(model->num_stretches(), 2);
+  EXPECT_EQ(model->num_segments(), 5 + 3);
+  EXPECT_EQ(NumWeights(*model), (5 + 3) * 3 * 40);
+  EXPECT_TRUE(model->PoseAt(4.5e5).terms.empty());
+  // The last segment of a stretch reaches 4 lengthscales past it.
+  EXPECT_EQ(model->PoseAt(100.0 + 11.5).terms.front().block, 3 * 4);
+  EXPECT_TRUE(model->PoseAt(100.0 + 12.5).terms.empty());
+  const auto alone =
+      FeatureTrajectory::Create(options, ZeroMean(), 9e5, 9e5 + 50.0, &error);
+  ASSERT_TRUE(alone) << error;
+  ASSERT_EQ(alone->num_segments(), 3);
+  for (const double t : {9e5, 9e5 + 17.5, 9e5 + 50.0}) {
+    const PoseMap joint = model->PoseAt(t), single = alone->PoseAt(t);
+    ASSERT_EQ(joint.terms.size(), single.terms.size()) << t;
+    for (std::size_t i = 0; i < joint.terms.size(); ++i) {
+      EXPECT_EQ(joint.terms[i].block, single.terms[i].block + 3 * 5);
+      EXPECT_EQ(*joint.terms[i].phi, *single.terms[i].phi) << t;
+    }
+  }
+}
+
+// A time only evaluated (a ground-truth pose) 1e6 s from the data adds no
+// segment: it is the prior mean. One near the data widens its stretch.
+TEST(FeatureTrajectoryTest, StrayQueryAddsNoSegments) {
+  DataTimes times;
+  times.constraints = {{0.0, 100.0}};
+  times.queries = {50.0, 1e6};
+  std::string error;
+  const auto model =
+      FeatureTrajectory::Create(WindowedOptions(), ZeroMean(), times, &error);
+  ASSERT_TRUE(model) << error;
+  EXPECT_EQ(model->num_stretches(), 1);
+  EXPECT_EQ(model->num_segments(), 5);
+  EXPECT_TRUE(model->PoseAt(1e6).terms.empty());
+  times.queries = {125.0};
+  EXPECT_EQ(
+      FeatureTrajectory::Create(WindowedOptions(), ZeroMean(), times, &error)
+          ->num_segments(),
+      7);
+}
+
+// The size check counts the segments of every stretch, and says so.
+TEST(FeatureTrajectoryTest, MoreWeightsThanMemoryAllowsOverStretchesFails) {
+  FeatureTrajectoryOptions options;
+  options.num_position_features = 1024;
+  options.num_heading_features = 1024;
+  options.segment_length = 1.0;
+  DataTimes times;
+  times.constraints = {{0.0, 100.0}, {1e6, 1e6 + 50.0}};
+  std::string error;
+  EXPECT_EQ(FeatureTrajectory::Create(options, ZeroMean(), times, &error),
+            nullptr);
+  EXPECT_EQ(error,
+            "--num_features=1024: the data's 150 s (in 2 stretches) need 150 "
+            "segments of 1024 features (x, y) and 1024 (theta): more weights "
+            "than memory allows; allowed at most 666 (as many for theta) for "
+            "this run, or --segment_length of at least 2.380952380952381");
+}
+
 }  // namespace
 }  // namespace rff

@@ -5,6 +5,7 @@
 #include <map>
 #include <set>
 
+#include "Eigen/Geometry"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
 #include "rff_ceres/linear_system_size.h"
@@ -127,6 +128,150 @@ TEST(SlamSolverTest, ShiftingTheSceneShiftsTheAnswer) {
                 ApeTranslation(dataset, near_result), 1e-4)
         << prior;
   }
+}
+
+// The dataset turned by `angle` about the origin (measurements and odometry
+// are in the robot's frame: they stay).
+Dataset Turned(Dataset dataset, double angle) {
+  const Eigen::Rotation2Dd turn(angle);
+  auto move = [&](double* x, double* y) {
+    const Eigen::Vector2d turned = turn * Eigen::Vector2d(*x, *y);
+    *x = turned.x();
+    *y = turned.y();
+  };
+  for (PosePrior& p : dataset.pose_priors) {
+    move(&p.pose.x, &p.pose.y);
+    p.pose.theta += angle;
+  }
+  for (TimedPose& p : dataset.ground_truth) {
+    move(&p.x, &p.y);
+    p.theta += angle;
+  }
+  for (LandmarkPrior& p : dataset.landmark_priors) move(&p.x, &p.y);
+  for (Landmark& l : dataset.ground_truth_landmarks) move(&l.x, &l.y);
+  return dataset;
+}
+
+// `later` appended `dt` seconds after `first`, its landmarks renamed past
+// `first`'s: two stretches of data with nothing in common.
+Dataset AppendedLater(const Dataset& first, Dataset later, double dt,
+                      LandmarkId id_offset) {
+  for (PosePrior& p : later.pose_priors) p.pose.t += dt;
+  for (LandmarkPrior& p : later.landmark_priors) p.id += id_offset;
+  for (Odometry& o : later.odometry) {
+    o.t0 += dt;
+    o.t1 += dt;
+  }
+  for (Observation& o : later.observations) {
+    o.t += dt;
+    o.id += id_offset;
+  }
+  for (TimedPose& p : later.ground_truth) p.t += dt;
+  for (Landmark& l : later.ground_truth_landmarks) l.id += id_offset;
+  Dataset joint = first;
+  auto append = [](auto* to, const auto& from) {
+    to->insert(to->end(), from.begin(), from.end());
+  };
+  append(&joint.pose_priors, later.pose_priors);
+  append(&joint.landmark_priors, later.landmark_priors);
+  append(&joint.odometry, later.odometry);
+  append(&joint.observations, later.observations);
+  append(&joint.ground_truth, later.ground_truth);
+  append(&joint.ground_truth_landmarks, later.ground_truth_landmarks);
+  return joint;
+}
+
+// APE of the part of `result` in [t_begin, t_end] with landmark ids in
+// [first_id, first_id + id_count), against that part of `dataset`.
+double PartApe(const Dataset& dataset, const SlamResult& result, double t_begin,
+               double t_end, LandmarkId first_id, LandmarkId id_count) {
+  auto in_time = [&](double t) { return t >= t_begin && t <= t_end; };
+  auto in_ids = [&](LandmarkId id) {
+    return id >= first_id && id < first_id + id_count;
+  };
+  Dataset truth;
+  SlamResult part;
+  for (const TimedPose& p : dataset.ground_truth) {
+    if (in_time(p.t)) truth.ground_truth.push_back(p);
+  }
+  for (const Landmark& l : dataset.ground_truth_landmarks) {
+    if (in_ids(l.id)) truth.ground_truth_landmarks.push_back(l);
+  }
+  for (const TimedPose& p : result.trajectory) {
+    if (in_time(p.t)) part.trajectory.push_back(p);
+  }
+  for (const Landmark& l : result.landmarks) {
+    if (in_ids(l.id)) part.landmarks.push_back(l);
+  }
+  return ApeTranslation(truth, part);
+}
+
+// Segments only where data is: two runs 9e5 s apart solve as each alone
+// (the weights of both and nothing between), to each one's APE.
+TEST(SlamSolverTest, RunsFarApartInTimeSolveAsEachAlone) {
+  Dataset first, later;
+  std::string error;
+  ASSERT_TRUE(Simulate(PaperOptions(5), &first, &error)) << error;
+  ASSERT_TRUE(Simulate(PaperOptions(6), &later, &error)) << error;
+  // Both from the origin at one heading: the constant mean is each one's.
+  later = Turned(
+      later, first.pose_priors[0].pose.theta - later.pose_priors[0].pose.theta);
+  const double dt = 9e5;
+  const LandmarkId id_offset = 1000;
+  const Dataset joint = AppendedLater(first, later, dt, id_offset);
+  const Dataset later_alone = AppendedLater(Dataset(), later, dt, id_offset);
+  SlamOptions options = PaperSolverOptions();
+  // What the whole run shares is made each run's own: the constant mean
+  // (the earliest pose prior), the start (dead reckoning would carry the
+  // first run's end into the second: the truth here) and the losses.
+  options.prior_mean = "constant";
+  options.problem.loss.name = "none";
+  options.problem.odometry_loss.name = "none";
+  // Converged to rounding: the joint solve takes other steps.
+  options.solver.function_tolerance = 0.0;
+  options.solver.gradient_tolerance = 1e-12;
+  options.solver.parameter_tolerance = 1e-12;
+  SlamResult joint_result, first_result, later_result;
+  options.initial_poses = joint.ground_truth;
+  ASSERT_TRUE(RunSlam(joint, options, &joint_result, &error)) << error;
+  options.initial_poses = first.ground_truth;
+  ASSERT_TRUE(RunSlam(first, options, &first_result, &error)) << error;
+  options.initial_poses = later_alone.ground_truth;
+  ASSERT_TRUE(RunSlam(later_alone, options, &later_result, &error)) << error;
+  // 300 s at 1 Hz in 50 s segments: 6 per run, 3 x 24 weights each.
+  EXPECT_EQ(first_result.summary.num_parameters,
+            6 * 3 * 24 + 2 * static_cast<int>(first_result.landmarks.size()));
+  EXPECT_EQ(joint_result.summary.num_parameters,
+            first_result.summary.num_parameters +
+                later_result.summary.num_parameters);
+  EXPECT_NEAR(joint_result.summary.final_cost,
+              first_result.summary.final_cost + later_result.summary.final_cost,
+              1e-6);
+  EXPECT_NEAR(PartApe(joint, joint_result, 0.0, 1e3, 0, id_offset),
+              ApeTranslation(first, first_result), 1e-9);
+  EXPECT_NEAR(PartApe(joint, joint_result, dt, dt + 1e3, id_offset, id_offset),
+              ApeTranslation(later_alone, later_result), 1e-9);
+}
+
+// A ground-truth pose 1e6 s after the run adds no segment: it is the prior
+// mean there, and the run's solution is the same bit for bit.
+TEST(SlamSolverTest, StrayGroundTruthPoseAddsNoSegments) {
+  Dataset dataset;
+  std::string error;
+  ASSERT_TRUE(Simulate(PaperOptions(5), &dataset, &error)) << error;
+  Dataset stray = dataset;
+  stray.ground_truth.push_back({1e6, 3.0, 4.0, 0.5});
+  const SlamOptions options = PaperSolverOptions();
+  SlamResult result, stray_result;
+  ASSERT_TRUE(RunSlam(dataset, options, &result, &error)) << error;
+  ASSERT_TRUE(RunSlam(stray, options, &stray_result, &error)) << error;
+  EXPECT_EQ(stray_result.summary.num_parameters, result.summary.num_parameters);
+  ASSERT_EQ(stray_result.trajectory.size(), result.trajectory.size() + 1);
+  for (std::size_t i = 0; i < result.trajectory.size(); ++i) {
+    EXPECT_EQ(stray_result.trajectory[i].x, result.trajectory[i].x);
+    EXPECT_EQ(stray_result.trajectory[i].y, result.trajectory[i].y);
+  }
+  EXPECT_EQ(stray_result.trajectory.back().t, 1e6);
 }
 
 TEST(SlamSolverTest, SplineRoundsKeepTheAccuracy) {
