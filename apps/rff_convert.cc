@@ -336,7 +336,7 @@ int main(int argc, char** argv) {
   if (FLAGS_output.empty()) {
     return Fail("--output=OUT." + FLAGS_to + " is required");
   }
-  if (!rff::CheckOutputPaths({{"--input", FLAGS_input}},
+  if (!rff::CheckOutputPaths(rff::WithFlagfiles({{"--input", FLAGS_input}}),
                              {{"--output", FLAGS_output}}, &error)) {
     return Fail(error);
   }

@@ -40,7 +40,7 @@ int main(int argc, char** argv) {
   if (FLAGS_output_trajectory.empty()) {
     return Fail("--output_trajectory is required");
   }
-  if (!rff::CheckOutputPaths({{"--dataset", FLAGS_dataset}},
+  if (!rff::CheckOutputPaths(rff::WithFlagfiles({{"--dataset", FLAGS_dataset}}),
                              {{"--output_trajectory", FLAGS_output_trajectory}},
                              &error)) {
     return Fail(error);

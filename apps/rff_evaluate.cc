@@ -48,11 +48,12 @@ int main(int argc, char** argv) {
   if (!rff::ParseToolFlags(&argc, &argv, &error)) return Fail(error);
   if (FLAGS_dataset.empty()) return Fail("--dataset is required");
   if (FLAGS_trajectory.empty()) return Fail("--trajectory is required");
-  if (!rff::CheckOutputPaths({{"--dataset", FLAGS_dataset},
+  if (!rff::CheckOutputPaths(
+          rff::WithFlagfiles({{"--dataset", FLAGS_dataset},
                               {"--trajectory", FLAGS_trajectory},
                               {"--landmarks", FLAGS_landmarks},
-                              {"--covariance", FLAGS_covariance}},
-                             {{"--json", FLAGS_json}}, &error)) {
+                              {"--covariance", FLAGS_covariance}}),
+          {{"--json", FLAGS_json}}, &error)) {
     return Fail(error);
   }
 

@@ -49,7 +49,7 @@ int main(int argc, char** argv) {
   if (!rff::ParseToolFlags(&argc, &argv, &error)) return Fail(error);
   if (FLAGS_input.empty()) return Fail("--input is required");
   if (FLAGS_output.empty()) return Fail("--output is required");
-  if (!rff::CheckOutputPaths({{"--input", FLAGS_input}},
+  if (!rff::CheckOutputPaths(rff::WithFlagfiles({{"--input", FLAGS_input}}),
                              {{"--output", FLAGS_output}}, &error)) {
     return Fail(error);
   }

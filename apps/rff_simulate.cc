@@ -109,7 +109,8 @@ int main(int argc, char** argv) {
   std::string error;
   if (!rff::ParseToolFlags(&argc, &argv, &error)) return Fail(error);
   if (FLAGS_output.empty()) return Fail("--output is required");
-  if (!rff::CheckOutputPaths({}, {{"--output", FLAGS_output}}, &error)) {
+  if (!rff::CheckOutputPaths(rff::WithFlagfiles({}),
+                             {{"--output", FLAGS_output}}, &error)) {
     return Fail(error);
   }
 

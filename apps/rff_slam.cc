@@ -61,7 +61,7 @@ int main(int argc, char** argv) {
   const rff::SlamOutputPaths outputs = {
       FLAGS_output_trajectory, FLAGS_output_landmarks, FLAGS_output_covariance,
       FLAGS_summary_json};
-  if (!rff::CheckOutputPaths({{"--dataset", FLAGS_dataset}},
+  if (!rff::CheckOutputPaths(rff::WithFlagfiles({{"--dataset", FLAGS_dataset}}),
                              {{"--output_trajectory", outputs.trajectory},
                               {"--output_landmarks", outputs.landmarks},
                               {"--output_covariance", outputs.covariance},

@@ -16,10 +16,27 @@ bool IsKnownToolFlag(const std::string& name) {
          info.type == "bool";
 }
 
+namespace {
+std::vector<std::string>& FlagfilesRead() {
+  static std::vector<std::string> read;
+  return read;
+}
+}  // namespace
+
+std::vector<NamedPath> WithFlagfiles(std::vector<NamedPath> inputs) {
+  for (const std::string& path : FlagfilesRead()) {
+    inputs.push_back({"--flagfile", path});
+  }
+  return inputs;
+}
+
 bool ParseToolFlags(int* argc, char*** argv, std::string* error) {
   std::signal(SIGXFSZ, SIG_IGN);
   const std::vector<std::string> args(*argv + 1, *argv + *argc);
-  if (!CheckFlagfiles(args, IsKnownToolFlag, error)) return false;
+  if (!CheckFlagfiles(args, IsKnownToolFlag, error, nullptr,
+                      &FlagfilesRead())) {
+    return false;
+  }
   gflags::ParseCommandLineFlags(argc, argv, true);
   if (*argc > 1) {
     *error = std::string("unexpected argument '") + (*argv)[1] + "'";

@@ -6,6 +6,9 @@
 #define RFF_APPS_TOOL_FLAGS_H_
 
 #include <string>
+#include <vector>
+
+#include "rff_ceres/io/output_file.h"
 
 namespace rff {
 
@@ -13,6 +16,10 @@ namespace rff {
 // a flagfile is bad or an argument is left over. gflags itself exits on an
 // unknown or malformed flag.
 bool ParseToolFlags(int* argc, char*** argv, std::string* error);
+
+// `inputs` and every flagfile ParseToolFlags read, for CheckOutputPaths: an
+// output never overwrites the flags it was given by.
+std::vector<NamedPath> WithFlagfiles(std::vector<NamedPath> inputs);
 
 // Whether the tool defines a flag of this name ("noname" for a boolean).
 bool IsKnownToolFlag(const std::string& name);

@@ -35,6 +35,7 @@ void WriteInputs(const std::string& dir) {
   WriteFile(dir + "/a.flags", "--flagfile=" + dir + "/b.flags\n");
   WriteFile(dir + "/b.flags", "--flagfile=" + dir + "/a.flags\n");
   WriteFile(dir + "/typo.flags", "--num_featurs=12\n");
+  WriteFile(dir + "/my.flags", "--lengthscale=10\n");
   std::string tiny = valid;
   for (std::size_t at = tiny.find("0.05 0.05 0.01"); at != std::string::npos;
        at = tiny.find("0.05 0.05 0.01", at)) {
@@ -110,6 +111,12 @@ const HostileCase kHostileCases[] = {
      "rff_slam: error: --summary_json={dir}/o.txt: the same file as the "
      "output --output_trajectory={dir}/o.txt; allowed a path of its own\n",
      "{dir}/o.txt"},
+    {"SlamOutputOnItsFlagfile",
+     SLAM "--flagfile={dir}/my.flags --output_trajectory={dir}/my.flags",
+     "rff_slam: error: --output_trajectory={dir}/my.flags: the same file as "
+     "the input --flagfile={dir}/my.flags, never overwritten; allowed "
+     "another path\n",
+     ""},
     {"SlamBadLandmarkDirectoryWritesNoTrajectory",
      SLAM OUT " --output_landmarks={dir}/no/l.txt",
      "rff_slam: error: --output_landmarks={dir}/no/l.txt: directory "

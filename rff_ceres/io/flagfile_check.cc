@@ -46,7 +46,8 @@ std::string Trim(const std::string& text) {
 
 bool CheckFlagfile(const std::string& path, const FlagIsKnown& is_known,
                    const FlagLineVisitor& on_flag,
-                   std::vector<std::string>* open, std::string* error) {
+                   std::vector<std::string>* open,
+                   std::vector<std::string>* read, std::string* error) {
   std::error_code ec;
   const std::string canonical =
       std::filesystem::weakly_canonical(path, ec).string();
@@ -75,6 +76,7 @@ bool CheckFlagfile(const std::string& path, const FlagIsKnown& is_known,
     return false;
   }
   open->push_back(canonical);
+  if (read) read->push_back(path);
   std::string line;
   for (int number = 1; std::getline(in, line); ++number) {
     const std::string text = Trim(line);
@@ -88,7 +90,7 @@ bool CheckFlagfile(const std::string& path, const FlagIsKnown& is_known,
     }
     if (name == "flagfile") {
       for (const std::string& nested : SplitCommas(FlagValue(text))) {
-        if (!CheckFlagfile(nested, is_known, on_flag, open, error)) {
+        if (!CheckFlagfile(nested, is_known, on_flag, open, read, error)) {
           return false;
         }
       }
@@ -107,7 +109,8 @@ bool CheckFlagfile(const std::string& path, const FlagIsKnown& is_known,
 
 bool CheckFlagfiles(const std::vector<std::string>& args,
                     const FlagIsKnown& is_known, std::string* error,
-                    const FlagLineVisitor& on_flag) {
+                    const FlagLineVisitor& on_flag,
+                    std::vector<std::string>* read) {
   for (std::size_t i = 0; i < args.size(); ++i) {
     if (args[i] == "--") break;
     if (FlagName(args[i]) != "flagfile") continue;
@@ -117,7 +120,9 @@ bool CheckFlagfiles(const std::vector<std::string>& args,
     }
     for (const std::string& path : SplitCommas(list)) {
       std::vector<std::string> open;
-      if (!CheckFlagfile(path, is_known, on_flag, &open, error)) return false;
+      if (!CheckFlagfile(path, is_known, on_flag, &open, read, error)) {
+        return false;
+      }
     }
   }
   return true;

@@ -26,10 +26,13 @@ using FlagLineVisitor = std::function<bool(
 // and in the flagfiles they name: each can be read, none includes itself
 // directly or through others, and every line is blank, a '#' comment or
 // --name[=value] with a known name. `error` names the file and line.
-// `on_flag`, when given, sees every flag line as it is checked.
+// `on_flag`, when given, sees every flag line as it is checked; `read`, when
+// given, gains the path of every flagfile read (inputs no output may
+// overwrite).
 bool CheckFlagfiles(const std::vector<std::string>& args,
                     const FlagIsKnown& is_known, std::string* error,
-                    const FlagLineVisitor& on_flag = nullptr);
+                    const FlagLineVisitor& on_flag = nullptr,
+                    std::vector<std::string>* read = nullptr);
 
 }  // namespace rff
 

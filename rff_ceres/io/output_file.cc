@@ -23,8 +23,11 @@ namespace fs = std::filesystem;
 // equal.
 fs::path Resolved(const std::string& path) {
   std::error_code ec;
-  fs::path resolved = fs::weakly_canonical(path, ec);
-  if (ec) resolved = fs::absolute(path, ec).lexically_normal();
+  // Absolute first: weakly_canonical keeps a relative path to a missing file
+  // relative ("o.txt") but makes "./o.txt" absolute.
+  const fs::path absolute = fs::absolute(path, ec).lexically_normal();
+  fs::path resolved = fs::weakly_canonical(absolute, ec);
+  if (ec) resolved = absolute;
   return resolved;
 }
 

@@ -119,6 +119,28 @@ TEST(CheckOutputPathsTest, RefusesTwoOutputsOnOnePath) {
                        dir + "/o.txt; allowed a path of its own");
 }
 
+// Relative spellings of one file that does not exist yet, from the working
+// directory: "o.txt", "./o.txt" and "../<dir>/o.txt" are one output.
+TEST(CheckOutputPathsTest, RefusesTwoRelativeSpellingsOfANewFile) {
+  const std::string dir = TempDir("CheckOutputPathsTest");
+  const std::filesystem::path previous = std::filesystem::current_path();
+  std::filesystem::current_path(dir);
+  const std::string name = std::filesystem::path(dir).filename().string();
+  std::string error;
+  const bool dot =
+      CheckOutputPaths({}, {{"--a", "new.txt"}, {"--b", "./new.txt"}}, &error);
+  const std::string dot_error = error;
+  const bool parent = CheckOutputPaths(
+      {}, {{"--a", "new.txt"}, {"--b", "../" + name + "/new.txt"}}, &error);
+  std::filesystem::current_path(previous);
+  EXPECT_FALSE(dot);
+  EXPECT_EQ(dot_error,
+            "--b=./new.txt: the same file as the output --a=new.txt; allowed "
+            "a path of its own");
+  EXPECT_FALSE(parent);
+  EXPECT_FALSE(std::filesystem::exists(dir + "/new.txt"));
+}
+
 TEST(CheckOutputPathsTest, RefusesAFileOfAnInputDirectory) {
   const std::string dir = TempDir("CheckOutputPathsTest");
   std::filesystem::create_directories(dir + "/raw");
