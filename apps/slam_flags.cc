@@ -54,11 +54,11 @@ DEFINE_int32(num_features, 0,
              "Features per coordinate of x and y (D) per segment; 0 (auto): "
              "D, the segment length and the overlap follow the lengthscales "
              "so that the motion the basis misses stays below 5 cm and "
-             "0.005 rad. At most 1024; even for rff, qmc and gauss_hermite, "
+             "0.005 rad. At most 512; even for rff, qmc and gauss_hermite, "
              "odd for the periodic kernel. Segments x (2 D^2 + D_theta^2) "
              "is at most 2e8 (the prior's memory).");
 DEFINE_int32(num_heading_features, 0,
-             "Features of theta (0: --num_features). At most 1024; needs "
+             "Features of theta (0: --num_features). At most 512; needs "
              "--num_features > 0.");
 DEFINE_string(learn_hyperparameters, "auto",
               "Learn the prior's hyperparameters from the data: on, off or "

@@ -60,9 +60,9 @@ struct FeatureTrajectoryOptions {
 inline constexpr int kMaxAutoFeatures = 512;
 // Bounds of a requested basis: the whitening prior of a segment's D weights
 // is a dense D x D Jacobian block, the blocks of every segment are held at
-// once, and a dense system of 3 D weights costs O(D^3) per iteration (D =
-// 1000 takes about 15 s on an 11-pose run, D = 2048 more than 2 minutes).
-inline constexpr int kMaxFeatures = 1024;
+// once, and a dense system of 3 D weights costs O(D^3) per iteration with
+// Debian's reference BLAS (an 11-pose run: 4 s at D = 512, 67 s at 1024).
+inline constexpr int kMaxFeatures = 512;
 inline constexpr int kMaxSegments = 100000;
 inline constexpr double kMaxPriorNonZeros = 2e8;  // 1.6 GB of Jacobian.
 

@@ -83,7 +83,7 @@ const AppCase kAppCases[] = {
      "{dir}/out.tum"},
     {"SlamNegativeD", SLAM "--num_features=-5" SLAM_OUT,
      "rff_slam: error: --num_features=-5: allowed 0 (from the capacity rule) "
-     "to 1024\n",
+     "to 512\n",
      "{dir}/out.tum"},
     {"SlamBadLearning", SLAM "--learn_hyperparameters=maybe" SLAM_OUT,
      "rff_slam: error: --learn_hyperparameters=maybe: allowed auto, on or "

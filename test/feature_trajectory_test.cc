@@ -135,17 +135,17 @@ TEST(FeatureTrajectoryTest, OverlapNotShorterThanTheSegmentFails) {
 // and the segment length that fit this run.
 TEST(FeatureTrajectoryTest, MoreWeightsThanMemoryAllowsFails) {
   FeatureTrajectoryOptions options;
-  options.num_position_features = 1024;
-  options.num_heading_features = 1024;
-  options.segment_length = 1.0;
+  options.num_position_features = 512;
+  options.num_heading_features = 512;
+  options.segment_length = 0.25;
   std::string error;
   EXPECT_EQ(FeatureTrajectory::Create(options, ZeroMean(), 0.0, 100.0, &error),
             nullptr);
   EXPECT_EQ(error,
-            "--num_features=1024: the run's 100 s need 100 segments of 1024 "
-            "features (x, y) and 1024 (theta): more weights than memory "
-            "allows; allowed at most 816 (as many for theta) for this run, or "
-            "--segment_length of at least 1.5873015873015872");
+            "--num_features=512: the run's 100 s need 400 segments of 512 "
+            "features (x, y) and 512 (theta): more weights than memory "
+            "allows; allowed at most 408 (as many for theta) for this run, or "
+            "--segment_length of at least 0.3937007874015748");
 }
 
 // Options of the windowed-weight tests: 40 features per map, segments of
@@ -219,19 +219,19 @@ TEST(FeatureTrajectoryTest, StrayQueryAddsNoSegments) {
 // The size check counts the segments of every stretch, and says so.
 TEST(FeatureTrajectoryTest, MoreWeightsThanMemoryAllowsOverStretchesFails) {
   FeatureTrajectoryOptions options;
-  options.num_position_features = 1024;
-  options.num_heading_features = 1024;
-  options.segment_length = 1.0;
+  options.num_position_features = 512;
+  options.num_heading_features = 512;
+  options.segment_length = 0.25;
   DataTimes times;
   times.constraints = {{0.0, 100.0}, {1e6, 1e6 + 50.0}};
   std::string error;
   EXPECT_EQ(FeatureTrajectory::Create(options, ZeroMean(), times, &error),
             nullptr);
   EXPECT_EQ(error,
-            "--num_features=1024: the data's 150 s (in 2 stretches) need 150 "
-            "segments of 1024 features (x, y) and 1024 (theta): more weights "
-            "than memory allows; allowed at most 666 (as many for theta) for "
-            "this run, or --segment_length of at least 2.380952380952381");
+            "--num_features=512: the data's 150 s (in 2 stretches) need 600 "
+            "segments of 512 features (x, y) and 512 (theta): more weights "
+            "than memory allows; allowed at most 333 (as many for theta) for "
+            "this run, or --segment_length of at least 0.5905511811023622");
 }
 
 }  // namespace

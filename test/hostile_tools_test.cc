@@ -149,16 +149,16 @@ const HostileCase kHostileCases[] = {
     // Sizes no machine can solve.
     {"Features30000", SLAM "--num_features=30000" OUT,
      "rff_slam: error: --num_features=30000: allowed 0 (from the capacity "
-     "rule) to 1024\n",
+     "rule) to 512\n",
      "{dir}/out.tum"},
     {"Features65535", SLAM "--num_features=65535" OUT,
      "rff_slam: error: --num_features=65535: allowed 0 (from the capacity "
-     "rule) to 1024\n",
+     "rule) to 512\n",
      "{dir}/out.tum"},
     {"HeadingFeatures65536",
      SLAM "--num_features=10 --num_heading_features=65536" OUT,
      "rff_slam: error: --num_heading_features=65536: allowed 0 (from the "
-     "capacity rule) to 1024\n",
+     "capacity rule) to 512\n",
      "{dir}/out.tum"},
     {"HeadingFeaturesWithAutoCapacity", SLAM "--num_heading_features=50" OUT,
      "rff_slam: error: --num_heading_features=50: --num_features=0 derives "

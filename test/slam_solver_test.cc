@@ -384,7 +384,7 @@ INSTANTIATE_TEST_SUITE_P(
         BadOption{
             "NegativeFeatures",
             [](SlamOptions* o) { o->trajectory.num_position_features = -3; },
-            "--num_features=-3: allowed 0 (from the capacity rule) to 1024"},
+            "--num_features=-3: allowed 0 (from the capacity rule) to 512"},
         BadOption{"OddHeadingFeaturesOfRff",
                   [](SlamOptions* o) {
                     o->trajectory.family = "rff";
