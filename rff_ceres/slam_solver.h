@@ -93,7 +93,7 @@ struct SlamOptions {
   // from `trajectory`'s (hyperparameter_learning.h): "on", "off", or "auto",
   // on for data without odometry. With odometry the GP models the drift of
   // dead reckoning, which grows along the run: a stationary kernel learned
-  // on a window misjudges it (docs/hyperparameters.md has the measurements).
+  // on a window misjudges it (docs/prior_means.md, "RFF with odometry").
   std::string learn_hyperparameters = "auto";
   LearningOptions learning;
   WnoaOptions wnoa;
