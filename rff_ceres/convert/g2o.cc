@@ -427,11 +427,7 @@ bool WriteG2o(const Dataset& input, std::ostream* output,
             << "\n";
     } else if (o.type == ObservationType::kRangeBearing) {
       RelativePosition p;
-      if (!ToRelativePosition(o, &p, error)) {
-        *error = "RANGE_BEARING at t = " + n(o.t) + " to landmark " +
-                 std::to_string(o.id) + ": " + *error;
-        return false;
-      }
+      if (!ToRelativePosition(o, &p, error)) return false;
       const Eigen::Matrix2d information = p.covariance.inverse();
       edges << "EDGE_SE2_XY " << ids
             << JoinNumbers({p.x, p.y, information(0, 0),

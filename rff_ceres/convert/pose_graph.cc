@@ -45,7 +45,9 @@ bool ToRelativePosition(const Observation& range_bearing,
                         RelativePosition* position, std::string* error) {
   const double r = range_bearing.range;
   if (!(r > 0.0)) {
-    *error = "range " + FormatNumber(r) +
+    *error = "RANGE_BEARING at t = " + FormatNumber(range_bearing.t) +
+             " to landmark " + std::to_string(range_bearing.id) + ": range " +
+             FormatNumber(r) +
              " is not > 0: no relative position with a covariance";
     return false;
   }

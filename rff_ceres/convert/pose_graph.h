@@ -34,7 +34,8 @@ struct RelativePosition {
 
 // A RANGE_BEARING record as a relative position; the covariance is
 // propagated to first order, J diag(sr^2, sb^2) J^T with J = d(x, y)/d(r, b).
-// Fails when the range is not > 0 (no direction, singular J).
+// Fails, naming the record, when the range is not > 0 (no direction,
+// singular J).
 bool ToRelativePosition(const Observation& range_bearing,
                         RelativePosition* position, std::string* error);
 

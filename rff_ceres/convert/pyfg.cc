@@ -549,11 +549,7 @@ bool WritePyfg(const Dataset& dataset, std::ostream* output,
           << JoinNumbers({o.range, o.sigma_range * o.sigma_range}) << "\n";
     } else if (o.type == ObservationType::kRangeBearing) {
       RelativePosition p;
-      if (!ToRelativePosition(o, &p, error)) {
-        *error = "RANGE_BEARING at t = " + n(o.t) + " to landmark " +
-                 std::to_string(o.id) + ": " + *error;
-        return false;
-      }
+      if (!ToRelativePosition(o, &p, error)) return false;
       const Eigen::Matrix2d& c = p.covariance;
       // + 0: a cross term of -0 is written as 0.
       out << "EDGE_SE2_XY" << edge
