@@ -176,8 +176,7 @@ std::vector<double> OutputTimes(const Dataset& dataset) {
 std::unique_ptr<TrajectoryModel> CreateTrajectoryModel(
     const Dataset& dataset, const SlamOptions& options,
     std::shared_ptr<const MeanFunction> mean, std::string* error) {
-  double t_begin, t_end;
-  TimeSpan(dataset, &t_begin, &t_end);
+  const std::string mean_name = SettlePriorMean(options, dataset);
   std::unique_ptr<TrajectoryModel> model;
   if (options.prior == "rff") {
     model = FeatureTrajectory::Create(options.trajectory, mean,
@@ -188,10 +187,12 @@ std::unique_ptr<TrajectoryModel> CreateTrajectoryModel(
     // to the states: one at each end of every odometry residual too, or the
     // cubic between states could not follow it (a 64 s stretch without
     // observations would be one cubic).
+    double t_begin, t_end;
+    TimeSpan(dataset, &t_begin, &t_end);
     std::vector<double> times = {t_begin, t_end};
     for (const Observation& o : dataset.observations) times.push_back(o.t);
     std::vector<PreintegratedOdometry> chains;
-    if (SettlePriorMean(options, dataset) == "constant" &&
+    if (mean_name == "constant" &&
         !OdometryChains(dataset, options.problem, &chains, error)) {
       return nullptr;
     }
@@ -205,7 +206,7 @@ std::unique_ptr<TrajectoryModel> CreateTrajectoryModel(
         OptionError("prior", options.prior, "unknown prior", "rff or wnoa");
     return nullptr;
   }
-  if (!model || SettlePriorMean(options, dataset) != "odometry") return model;
+  if (!model || mean_name != "odometry") return model;
   // Dead reckoning carries the error of its start heading: let it turn.
   const PosePrior& start = EarliestPosePrior(dataset);
   return std::make_unique<MeanRotationTrajectory>(
@@ -714,9 +715,28 @@ bool LearnPriorScales(const Dataset& dataset,
   return true;
 }
 
-// Settles "auto" losses (slam_problem.h) after a robust solve: a loss whose
-// residual kinds all stay within the outlier level of their count becomes
-// "none", the rest "cauchy". Returns whether any became "none".
+constexpr double kJudgingTolerance = 1e-4;
+
+bool HasAutoLoss(const ProblemOptions& options) {
+  return options.loss.name == "auto" || options.odometry_loss.name == "auto";
+}
+
+// The robust solve that judges "auto" losses stops at a relative cost change
+// of 1e-4: the judgement compares residuals with an outlier level of several
+// sigma and needs no full convergence; the solve after it finishes.
+ceres::Solver::Options JudgingOptions(const ProblemOptions& options,
+                                      ceres::Solver::Options ceres_options) {
+  if (HasAutoLoss(options)) {
+    ceres_options.function_tolerance =
+        std::max(ceres_options.function_tolerance, kJudgingTolerance);
+  }
+  return ceres_options;
+}
+
+// Settles "auto" losses (slam_problem.h) after the robust solve that judges
+// them (JudgingOptions): a loss whose residual kinds all stay within the
+// outlier level of their count becomes "none", the rest "cauchy". Returns
+// whether any was "auto", so that the judging solve is to be finished.
 bool SettleAutoLosses(SlamProblem* problem, ProblemOptions* options) {
   const std::map<std::string, std::vector<double>> residuals =
       problem->WhitenedResidualsByKind();
@@ -731,33 +751,13 @@ bool SettleAutoLosses(SlamProblem* problem, ProblemOptions* options) {
     }
     return true;
   };
-  bool dropped = false;
+  const bool judged = HasAutoLoss(*options);
   auto settle = [&](bool is_clean, LossOptions* loss) {
-    if (loss->name != "auto") return;
-    loss->name = is_clean ? "none" : "cauchy";
-    dropped = dropped || is_clean;
+    if (loss->name == "auto") loss->name = is_clean ? "none" : "cauchy";
   };
   settle(clean({"range", "bearing", "range-bearing"}), &options->loss);
   settle(clean({"odometry"}), &options->odometry_loss);
-  return dropped;
-}
-
-constexpr double kJudgingTolerance = 1e-4;
-
-bool HasAutoLoss(const ProblemOptions& options) {
-  return options.loss.name == "auto" || options.odometry_loss.name == "auto";
-}
-
-// The robust solve that judges "auto" losses stops at a relative cost change
-// of 1e-4, where residuals still move by hundredths of a sigma against an
-// outlier level of several; the solve after the judgement finishes it.
-ceres::Solver::Options JudgingOptions(const SlamOptions& options,
-                                      ceres::Solver::Options ceres_options) {
-  if (HasAutoLoss(options.problem)) {
-    ceres_options.function_tolerance =
-        std::max(ceres_options.function_tolerance, kJudgingTolerance);
-  }
-  return ceres_options;
+  return judged;
 }
 
 // Adds the covariance of a mean that is itself an estimate (the WNOA
@@ -978,7 +978,6 @@ bool RunSlamAtOrigin(const Dataset& dataset, const SlamOptions& options,
     ceres_options.callbacks.push_back(&abort_check);
   }
   std::unique_ptr<SlamProblem> problem;
-  const bool judging = incremental.every == 0 && HasAutoLoss(settled.problem);
   if (incremental.every > 0) {
     if (!SolveIncremental(dataset, settled, ceres_options, model.get(),
                           &landmarks, &problem, result, error) ||
@@ -987,10 +986,11 @@ bool RunSlamAtOrigin(const Dataset& dataset, const SlamOptions& options,
       return false;
     }
   } else if (!SolveBatch(dataset, settled,
-                         JudgingOptions(settled, ceres_options), model.get(),
-                         &landmarks, initial_extent, &problem, result, error)) {
+                         JudgingOptions(settled.problem, ceres_options),
+                         model.get(), &landmarks, initial_extent, &problem,
+                         result, error)) {
     return false;
-  } else if ((SettleAutoLosses(problem.get(), &settled.problem) || judging) &&
+  } else if (SettleAutoLosses(problem.get(), &settled.problem) &&
              !SolveBatch(dataset, settled, ceres_options, model.get(),
                          &landmarks, initial_extent, &problem, result, error)) {
     return false;
