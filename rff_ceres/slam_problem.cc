@@ -282,8 +282,8 @@ std::string SlamProblem::Describe(ceres::ResidualBlockId id) const {
   return text;
 }
 
-std::map<std::string, std::vector<double>>
-SlamProblem::WhitenedResidualsByKind() {
+std::map<std::string, std::vector<double>> SlamProblem::WhitenedResidualsByKind(
+    bool stated_sigmas) {
   std::map<std::string, std::vector<double>> by_kind;
   std::vector<ceres::ResidualBlockId> ids;
   problem_->GetResidualBlocks(&ids);
@@ -299,6 +299,17 @@ SlamProblem::WhitenedResidualsByKind() {
     if (!problem_->EvaluateResidualBlock(id, /*apply_loss_function=*/false,
                                          &cost, residuals.data(), nullptr)) {
       continue;
+    }
+    if (stated_sigmas) {
+      const std::string kind(name);
+      const NoiseScales& n = options_.noise;
+      for (std::size_t row = 0; row < residuals.size(); ++row) {
+        residuals[row] *=
+            kind == "odometry" ? n.odometry
+            : kind == "range" || (kind == "range-bearing" && row == 0) ? n.range
+            : kind == "bearing" || kind == "range-bearing" ? n.bearing
+                                                           : 1.0;
+      }
     }
     std::vector<double>& kind = by_kind[name];
     kind.insert(kind.end(), residuals.begin(), residuals.end());

@@ -187,7 +187,10 @@ class SlamProblem {
   // grouped by what they are: "range", "bearing", "range-bearing",
   // "odometry", "landmark prior", "pose prior", "range calibration prior"
   // and "trajectory prior" (the model's own: RFF weights, WNOA motion).
-  std::map<std::string, std::vector<double>> WhitenedResidualsByKind();
+  // With `stated_sigmas`, whitened by the data's own sigmas rather than the
+  // noise-scaled ones the problem is solved with.
+  std::map<std::string, std::vector<double>> WhitenedResidualsByKind(
+      bool stated_sigmas = false);
   bool CheckLandmarksDetermined(double max_condition, std::string* error);
   // The variance group of every row of the residual blocks `ids`, in order.
   std::vector<VarianceGroup> RowGroups(

@@ -28,6 +28,15 @@ void UpdateTimes(const SlamResult& result, double* mean, double* max) {
   if (!result.updates.empty()) *mean /= result.updates.size();
 }
 
+// ["a", "b"]
+std::string JsonStringArray(const std::vector<std::string>& items) {
+  std::string out = "[";
+  for (std::size_t i = 0; i < items.size(); ++i) {
+    out += (i == 0 ? "" : ", ") + JsonString(items[i]);
+  }
+  return out + "]";
+}
+
 }  // namespace
 
 void PrintSlamSummary(const SlamOptions& options, const SlamResult& result,
@@ -70,6 +79,17 @@ void PrintSlamSummary(const SlamOptions& options, const SlamResult& result,
     *out << "  scales       " << (options.prior == "wnoa" ? "Q_c" : "variances")
          << " learned by variance components, " << result.learning_rounds
          << " rounds\n";
+  }
+  const NoiseScales& noise = result.noise;
+  if (noise.range != 1.0 || noise.bearing != 1.0 || noise.odometry != 1.0) {
+    *out << "  noise        sigmas learned as the stated ones times: range "
+         << noise.range << ", bearing " << noise.bearing << ", odometry "
+         << noise.odometry << "\n";
+  }
+  for (const std::string& kind : result.noise_kept) {
+    *out << "  noise        " << kind
+         << " sigma kept as stated: learning ran it towards 0 (its residuals "
+            "fit exactly, the likelihood's degenerate edge)\n";
   }
   if (!result.scales_not_learned.empty()) {
     *out << "  warning: the prior's scales were not learned: "
@@ -164,6 +184,14 @@ void WriteSummaryJson(const SlamOptions& options, const SlamResult& result,
       << "  \"prior_scale_factors\": ["
       << FormatNumber(result.prior_scale_factors[0]) << ", "
       << FormatNumber(result.prior_scale_factors[1]) << "],\n"
+      << "  \"noise_scale_range\": " << FormatNumber(result.noise.range)
+      << ",\n"
+      << "  \"noise_scale_bearing\": " << FormatNumber(result.noise.bearing)
+      << ",\n"
+      << "  \"noise_scale_odometry\": " << FormatNumber(result.noise.odometry)
+      << ",\n"
+      << "  \"noise_scales_kept\": " << JsonStringArray(result.noise_kept)
+      << ",\n"
       << "  \"learning_seconds\": " << FormatNumber(result.learning.seconds)
       << ",\n"
       << "  \"features\": " << JsonString(t.family) << ",\n"
@@ -216,11 +244,8 @@ void WriteSummaryJson(const SlamOptions& options, const SlamResult& result,
       << "  \"odometry_turn_scale\": "
       << FormatNumber(result.odometry_calibration[1]) << ",\n"
       << "  \"quality\": " << JsonString(result.quality.verdict) << ",\n"
-      << "  \"quality_reasons\": [";
-  for (std::size_t i = 0; i < result.quality.reasons.size(); ++i) {
-    out << (i == 0 ? "" : ", ") << JsonString(result.quality.reasons[i]);
-  }
-  out << "],\n  \"residuals\": {";
+      << "  \"quality_reasons\": " << JsonStringArray(result.quality.reasons)
+      << ",\n  \"residuals\": {";
   for (std::size_t i = 0; i < result.quality.kinds.size(); ++i) {
     const ResidualKindQuality& q = result.quality.kinds[i];
     out << (i == 0 ? "\n" : ",\n") << "    " << JsonString(q.kind)

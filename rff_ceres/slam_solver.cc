@@ -644,27 +644,44 @@ bool InitializeBlocks(const Dataset& start, const SlamOptions& options,
   return true;
 }
 
+// Solves whose result only places the next step (the judging of "auto"
+// losses, a round of learned scales) stop at this relative cost change: the
+// factors and outlier levels they feed are far coarser.
+constexpr double kPlacingTolerance = 1e-4;
+
 // Learns the scales of the trajectory prior (WNOA Q_c, RFF kernel
-// variances) of x, y and theta: after the first MAP, each round rescales
-// them by their variance-component factors (variance_components.h,
-// MacKay's fixed point of the Laplace evidence) and solves again from the
-// current estimate, until every factor is within kScaleTolerance of one.
-constexpr int kMaxScaleRounds = 6;
+// variances) of x, y and theta and, where `noise`, the factors on the sigmas
+// of range, bearing and odometry: after the first MAP, each round rescales
+// the variances by their variance-component factors (variance_components.h,
+// the fixed point of the Laplace evidence) and solves again from the current
+// estimate, until every factor is within kScaleTolerance of one. The data's
+// stated sigmas are often a guess: MRCLAM's bearings and odometry are
+// several times tighter than stated (docs/heldout.md). `loose`: the problem
+// was solved at kPlacingTolerance only.
+constexpr int kMaxScaleRounds = 12;
 constexpr double kScaleTolerance = 0.1;
 constexpr double kMaxScaleStep = 10.0;  // Per round, either way.
-bool LearnPriorScales(const Dataset& dataset,
-                      std::shared_ptr<const MeanFunction> mean,
-                      const ceres::Solver::Options& ceres_options,
-                      double initial_extent, SlamOptions* settled,
-                      std::unique_ptr<TrajectoryModel>* model,
-                      std::map<LandmarkId, Eigen::Vector2d>* landmarks,
-                      std::unique_ptr<SlamProblem>* problem, SlamResult* result,
-                      std::string* error) {
+constexpr int kAcceleratingFalls = 3;
+bool LearnScales(const Dataset& dataset,
+                 std::shared_ptr<const MeanFunction> mean,
+                 const ceres::Solver::Options& ceres_options,
+                 double initial_extent, bool noise, bool loose,
+                 SlamOptions* settled, std::unique_ptr<TrajectoryModel>* model,
+                 std::map<LandmarkId, Eigen::Vector2d>* landmarks,
+                 std::unique_ptr<SlamProblem>* problem, SlamResult* result,
+                 std::string* error) {
   const bool wnoa = settled->prior == "wnoa";
   double* position_scale = wnoa ? &settled->wnoa.position_qc
                                 : &settled->trajectory.position_kernel.variance;
   double* heading_scale = wnoa ? &settled->wnoa.heading_qc
                                : &settled->trajectory.heading_kernel.variance;
+  NoiseScales& sigmas = settled->problem.noise;
+  std::set<VarianceGroup> kept;  // Noise sigmas back at the stated ones.
+  std::map<VarianceGroup, double> last_fall;  // -log factor.
+  std::map<VarianceGroup, int> accelerating_falls;
+  ceres::Solver::Options placing_options = ceres_options;
+  placing_options.function_tolerance =
+      std::max(ceres_options.function_tolerance, kPlacingTolerance);
   for (int round = 0; round < kMaxScaleRounds; ++round) {
     VarianceComponents components;
     std::string why;
@@ -676,20 +693,45 @@ bool LearnPriorScales(const Dataset& dataset,
       return true;
     }
     double largest_step = 0.0;
-    auto rescale = [&](VarianceGroup group, double* scale) {
-      const double factor =
-          std::clamp(components[static_cast<int>(group)].factor,
-                     1.0 / kMaxScaleStep, kMaxScaleStep);
-      largest_step = std::max(largest_step, std::abs(std::log(factor)));
-      *scale *= factor;
+    // `power` 1 for a variance, 0.5 for a sigma.
+    auto rescale = [&](VarianceGroup group, double power, double* scale) {
+      const VarianceComponent& c = components[static_cast<int>(group)];
+      if (!c.estimated || kept.count(group) > 0) return;
+      // Rounds in a row this scale fell by more than the round before.
+      const double fall = -std::log(c.factor);
+      int& accelerating = accelerating_falls[group];
+      accelerating =
+          fall > 0.0 && fall >= last_fall[group] ? accelerating + 1 : 0;
+      last_fall[group] = fall;
+      if (power < 1.0 && accelerating > kAcceleratingFalls) {
+        // A noise sigma falling faster round after round runs to the
+        // likelihood's degenerate edge, its rows fit exactly as it goes to
+        // 0 (a misfit prior lets them): back to the stated one. A real
+        // scale's falls slow down towards its fixed point.
+        *scale = 1.0;
+        kept.insert(group);
+        result->noise_kept.push_back(VarianceGroupName(group));
+        largest_step = std::numeric_limits<double>::infinity();
+        return;
+      }
+      largest_step = std::max(largest_step, std::abs(std::log(c.factor)));
+      *scale *= std::pow(
+          std::clamp(c.factor, 1.0 / kMaxScaleStep, kMaxScaleStep), power);
     };
-    rescale(VarianceGroup::kPriorPosition, position_scale);
-    rescale(VarianceGroup::kPriorHeading, heading_scale);
+    rescale(VarianceGroup::kPriorPosition, 1.0, position_scale);
+    rescale(VarianceGroup::kPriorHeading, 1.0, heading_scale);
+    if (noise) {
+      rescale(VarianceGroup::kRange, 0.5, &sigmas.range);
+      rescale(VarianceGroup::kBearing, 0.5, &sigmas.bearing);
+      rescale(VarianceGroup::kOdometry, 0.5, &sigmas.odometry);
+    }
     VLOG(1)
-        << "prior scale round " << round << ": position factor "
+        << "scale round " << round << ": prior position factor "
         << components[static_cast<int>(VarianceGroup::kPriorPosition)].factor
         << ", heading factor "
-        << components[static_cast<int>(VarianceGroup::kPriorHeading)].factor;
+        << components[static_cast<int>(VarianceGroup::kPriorHeading)].factor
+        << "; sigma factors range " << sigmas.range << ", bearing "
+        << sigmas.bearing << ", odometry " << sigmas.odometry;
     result->learning_rounds = round + 1;
     result->prior_scale_factors
         << components[static_cast<int>(VarianceGroup::kPriorPosition)].factor,
@@ -706,29 +748,31 @@ bool LearnPriorScales(const Dataset& dataset,
     } else if (!FitModelToPoses(estimate, model->get(), error)) {
       return false;
     }
-    if (!SolveBatch(dataset, *settled, ceres_options, model->get(), landmarks,
+    if (!SolveBatch(dataset, *settled, placing_options, model->get(), landmarks,
                     initial_extent, problem, result, error)) {
       return false;
     }
     result->learned = true;
+    loose = true;
   }
-  return true;
+  // The rounds' solves only placed the next factors.
+  return !loose ||
+         SolveBatch(dataset, *settled, ceres_options, model->get(), landmarks,
+                    initial_extent, problem, result, error);
 }
-
-constexpr double kJudgingTolerance = 1e-4;
 
 bool HasAutoLoss(const ProblemOptions& options) {
   return options.loss.name == "auto" || options.odometry_loss.name == "auto";
 }
 
-// The robust solve that judges "auto" losses stops at a relative cost change
-// of 1e-4: the judgement compares residuals with an outlier level of several
-// sigma and needs no full convergence; the solve after it finishes.
+// The robust solve that judges "auto" losses stops at kPlacingTolerance: the
+// judgement compares residuals with an outlier level of several sigma; the
+// solve after it finishes.
 ceres::Solver::Options JudgingOptions(const ProblemOptions& options,
                                       ceres::Solver::Options ceres_options) {
   if (HasAutoLoss(options)) {
     ceres_options.function_tolerance =
-        std::max(ceres_options.function_tolerance, kJudgingTolerance);
+        std::max(ceres_options.function_tolerance, kPlacingTolerance);
   }
   return ceres_options;
 }
@@ -873,6 +917,7 @@ bool RunSlamAtOrigin(const Dataset& dataset, const SlamOptions& options,
     if (wnoa.odometry_loss == "none") {
       settled.problem.odometry_loss.name = "none";
     }
+    settled.problem.noise = wnoa.noise;  // Learned from the same data.
     if (wnoa_mean) {
       mean = std::make_shared<PiecewiseLinearMean>(wnoa.trajectory);
       wnoa_mean_solve = std::move(wnoa);
@@ -922,9 +967,14 @@ bool RunSlamAtOrigin(const Dataset& dataset, const SlamOptions& options,
   const bool search =
       options.learn_hyperparameters == "on" ||
       (options.learn_hyperparameters == "auto" && dataset.odometry.empty());
+  // WNOA learns its Q_c and the data's noise scales (LearnScales): its
+  // prior is the only motion model besides the odometry, whose sigmas, like
+  // the sensors', are the recording's guess.
+  const bool wnoa_learns =
+      options.prior == "wnoa" && options.learn_hyperparameters != "off";
   // With a "wnoa" mean the RFF weights are a correction to a solve of the
   // same data: its variances start at what the capacity rule resolves and
-  // are learned from the data (LearnPriorScales).
+  // are learned from the data (LearnScales).
   const bool correction = options.prior == "rff" &&
                           result->prior_mean == "wnoa" &&
                           options.learn_hyperparameters != "off";
@@ -990,16 +1040,20 @@ bool RunSlamAtOrigin(const Dataset& dataset, const SlamOptions& options,
                          model.get(), &landmarks, initial_extent, &problem,
                          result, error)) {
     return false;
-  } else if (SettleAutoLosses(problem.get(), &settled.problem) &&
-             !SolveBatch(dataset, settled, ceres_options, model.get(),
-                         &landmarks, initial_extent, &problem, result, error)) {
-    return false;
-  } else if (((options.prior == "wnoa" && search) || correction) &&
-             !LearnPriorScales(dataset, mean, ceres_options, initial_extent,
-                               &settled, &model, &landmarks, &problem, result,
-                               error)) {
+  } else if (!(wnoa_learns || correction)) {
+    if (SettleAutoLosses(problem.get(), &settled.problem) &&
+        !SolveBatch(dataset, settled, ceres_options, model.get(), &landmarks,
+                    initial_extent, &problem, result, error)) {
+      return false;
+    }
+  } else if (!LearnScales(dataset, mean, ceres_options, initial_extent,
+                          /*noise=*/wnoa_learns,
+                          SettleAutoLosses(problem.get(), &settled.problem),
+                          &settled, &model, &landmarks, &problem, result,
+                          error)) {
     return false;
   }
+  result->noise = settled.problem.noise;
   // Incremental updates keep an "auto" loss robust throughout.
   for (LossOptions* loss :
        {&settled.problem.loss, &settled.problem.odometry_loss}) {
@@ -1013,7 +1067,9 @@ bool RunSlamAtOrigin(const Dataset& dataset, const SlamOptions& options,
     result->trajectory_options = features->options();
   }
   if (!problem->CheckLandmarksDetermined(1e12, error)) return false;
-  result->quality = AssessQuality(problem->WhitenedResidualsByKind(),
+  // Judged against the data as stated: learned sigmas would absorb a misfit.
+  result->quality = AssessQuality(problem->WhitenedResidualsByKind(
+                                      /*stated_sigmas=*/true),
                                   SolveFactsOf(settled, *result));
   for (const auto& [id, position] : landmarks) {
     Landmark l;

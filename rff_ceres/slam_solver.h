@@ -146,6 +146,11 @@ struct SlamResult {
   // information matrix numerically singular); empty otherwise.
   std::string scales_not_learned;
   Eigen::Vector2d prior_scale_factors = Eigen::Vector2d::Ones();
+  // The factors on the data's sigmas the solve ended with: learned with the
+  // WNOA prior's scales (and passed on to an RFF solve about it), else 1.
+  NoiseScales noise;
+  // Kinds whose learned sigma ran towards 0 and went back to the stated one.
+  std::vector<std::string> noise_kept;
   // The linear solver used and why ("auto" settles on one per problem).
   std::string linear_solver;
   std::string linear_solver_reason;

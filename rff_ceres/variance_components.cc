@@ -97,6 +97,7 @@ bool EstimateVarianceComponents(SlamProblem* problem,
     if (g != static_cast<int>(VarianceGroup::kFixed) &&
         c.redundancy >= options.min_redundancy) {
       c.factor = c.sum_squares / c.redundancy;
+      c.estimated = true;
     }
   }
   return true;

@@ -31,6 +31,7 @@ struct VarianceComponent {
   double redundancy = 0.0;   // n_g - tr(H^-1 J_g^T J_g).
   // s_g; 1 where the group has no rows or too little redundancy to tell.
   double factor = 1.0;
+  bool estimated = false;  // factor is s_g, not the 1 of too few data.
 };
 
 struct VarianceComponentOptions {

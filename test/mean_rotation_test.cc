@@ -97,35 +97,41 @@ TEST(MeanRotationTest, OnlyTheInnerPriorIsRescaledAndDeltaIsShared) {
   EXPECT_FALSE(model->IsSharedBlock(1));
 }
 
-// A simulated run whose start heading prior is turned by 90 degrees and
+// Simulated runs whose start heading prior is turned by 90 degrees and
 // made uninformative (sigma pi): the solve resolves the heading, turns the
 // dead-reckoning mean and ends as accurate as with the true start heading
-// known to 1 mrad. Measured (seed 31): 0.200 m both ways; before the
-// rotation block the turned run ended at 0.54 m.
+// known to 1 mrad, over three seeds (one run varies by 15% either way with
+// the learned noise scales). Measured: 0.212 m known, 0.224 m unknown (WNOA
+// and RFF alike); before the rotation block a turned run ended at 0.54 m.
 TEST(MeanRotationTest, UnknownStartHeadingSolvesLikeAKnownOne) {
-  SimulationOptions sim = PaperOptions(31);
-  sim.landmark_prior_sigma = 1.0;
-  Dataset known;
-  std::string error;
-  ASSERT_TRUE(Simulate(sim, &known, &error)) << error;
-  Dataset turned = known;
-  PosePrior& start = EarliestPosePrior(&turned);
-  start.pose.theta = WrapAngle(start.pose.theta + 0.5 * M_PI);
-  start.sigma_theta = M_PI;
+  std::vector<Dataset> known, turned;
+  for (const int seed : {31, 32, 33}) {
+    SimulationOptions sim = PaperOptions(seed);
+    sim.landmark_prior_sigma = 1.0;
+    std::string error;
+    known.emplace_back();
+    ASSERT_TRUE(Simulate(sim, &known.back(), &error)) << error;
+    turned.push_back(known.back());
+    PosePrior& start = EarliestPosePrior(&turned.back());
+    start.pose.theta = WrapAngle(start.pose.theta + 0.5 * M_PI);
+    start.sigma_theta = M_PI;
+  }
   for (const std::string prior : {"wnoa", "rff"}) {
     SlamOptions options;
     options.prior = prior;
-    double ape[2];
+    double ape[2] = {0.0, 0.0};  // Mean over the seeds.
     for (int k = 0; k < 2; ++k) {
-      const Dataset& dataset = k == 0 ? known : turned;
-      SlamResult result;
-      ASSERT_TRUE(RunSlam(dataset, options, &result, &error)) << error;
-      Evaluation evaluation;
-      ASSERT_TRUE(Evaluate(dataset.ground_truth, dataset.ground_truth_landmarks,
-                           result.trajectory, nullptr, EvaluationOptions(),
-                           &evaluation, &error))
-          << error;
-      ape[k] = evaluation.ape_translation.rms;
+      for (const Dataset& dataset : k == 0 ? known : turned) {
+        SlamResult result;
+        std::string error;
+        ASSERT_TRUE(RunSlam(dataset, options, &result, &error)) << error;
+        Evaluation evaluation;
+        ASSERT_TRUE(Evaluate(dataset.ground_truth,
+                             dataset.ground_truth_landmarks, result.trajectory,
+                             nullptr, EvaluationOptions(), &evaluation, &error))
+            << error;
+        ape[k] += evaluation.ape_translation.rms / known.size();
+      }
     }
     std::printf("%s: known start heading %.4f m, unknown %.4f m\n",
                 prior.c_str(), ape[0], ape[1]);
