@@ -65,11 +65,12 @@ DEFINE_string(learn_hyperparameters, "auto",
               "auto. RFF: lengthscales and variances of x, y and theta by the "
               "evidence of the exact kernel with the observations linearised "
               "about a WNOA solve (auto: without odometry), and the variances "
-              "of the correction to a wnoa mean; WNOA: Q_c by variance "
-              "components (auto: without odometry, where the prior is the "
-              "only motion model). Batch mode only. auto is off when a "
-              "kernel hyperparameter or Q_c is given (command line or "
-              "flagfile): they are then the user's choice.");
+              "of the correction to a wnoa mean; WNOA: Q_c and the factors "
+              "on the data's stated sigmas (range, bearing, odometry) by "
+              "variance components, the RFF prior solving with those of its "
+              "WNOA mean. Batch mode only. auto is off when a kernel "
+              "hyperparameter or Q_c is given (command line or flagfile): "
+              "they are then the user's choice.");
 DEFINE_uint64(seed, 1, "Seed of the random feature frequencies.");
 DEFINE_double(segment_length, 0.0,
               "Windowed weights: segment length in seconds (0: one global "

@@ -94,6 +94,7 @@ struct SlamOptions {
   // on for data without odometry. With odometry the GP models the drift of
   // dead reckoning, which grows along the run: a stationary kernel learned
   // on a window misjudges it (docs/prior_means.md, "RFF with odometry").
+  // WNOA learns Q_c and the noise scales of the data unless "off".
   std::string learn_hyperparameters = "auto";
   LearningOptions learning;
   WnoaOptions wnoa;

@@ -179,6 +179,43 @@ TEST(VarianceComponentsTest, OdometrySigmaRunningToZeroKeepsTheStatedOne) {
   }
 }
 
+// The problem solves with the noise-scaled sigmas; its residuals at the
+// stated ones (what the quality verdict judges) are those times the scale of
+// each row's kind, and every other kind's are unchanged.
+TEST(VarianceComponentsTest, ResidualsAtTheStatedSigmasUndoTheNoiseScales) {
+  const Dataset dataset = WnoaDraw(3, 40, 0.05, 0.01);
+  SlamOptions options;
+  options.prior = "wnoa";
+  options.problem.noise.range = 0.5;
+  options.problem.noise.bearing = 4.0;
+  std::string error;
+  const std::shared_ptr<const MeanFunction> mean = BuildPriorMean(
+      "constant", dataset, options.localization, kPaperSplineSmoothing, &error);
+  ASSERT_NE(mean, nullptr) << error;
+  std::unique_ptr<TrajectoryModel> model =
+      CreateTrajectoryModel(dataset, options, mean, &error);
+  ASSERT_NE(model, nullptr) << error;
+  std::map<LandmarkId, Eigen::Vector2d> landmarks;
+  for (const Landmark& l : dataset.ground_truth_landmarks) {
+    landmarks[l.id] = Eigen::Vector2d(l.x + 0.3, l.y - 0.2);
+  }
+  SlamProblem problem(model.get(), options.problem);
+  ASSERT_TRUE(problem.Build(dataset, landmarks, &error)) << error;
+  const auto scaled = problem.WhitenedResidualsByKind();
+  const auto stated = problem.WhitenedResidualsByKind(/*stated_sigmas=*/true);
+  ASSERT_EQ(scaled.size(), stated.size());
+  for (const auto& [kind, rows] : scaled) {
+    const std::vector<double>& at_stated = stated.at(kind);
+    ASSERT_EQ(rows.size(), at_stated.size()) << kind;
+    for (std::size_t r = 0; r < rows.size(); ++r) {
+      const double factor =
+          kind == "range-bearing" ? (r % 2 == 0 ? 0.5 : 4.0) : 1.0;
+      EXPECT_DOUBLE_EQ(at_stated[r], factor * rows[r]) << kind << " " << r;
+    }
+  }
+  EXPECT_GT(scaled.at("range-bearing").size(), 0u);
+}
+
 // The Hutchinson redundancies match the exact traces of H^-1 J_g^T J_g
 // (dense inverse) on a small problem, and the factors are r^T r / redundancy.
 void ExpectRedundanciesMatchTheExactTraces(const SlamOptions& given) {
