@@ -110,6 +110,27 @@ TEST(VarianceComponentsTest, WnoaLearningRecoversTheDensities) {
   }
 }
 
+// The model of `options` about a constant mean, and the true landmarks
+// moved by `offset`: a problem to build without solving the run first.
+void ModelAboutAConstantMean(const Dataset& dataset, const SlamOptions& options,
+                             std::unique_ptr<TrajectoryModel>* model) {
+  std::string error;
+  const std::shared_ptr<const MeanFunction> mean = BuildPriorMean(
+      "constant", dataset, options.localization, kPaperSplineSmoothing, &error);
+  ASSERT_NE(mean, nullptr) << error;
+  *model = CreateTrajectoryModel(dataset, options, mean, &error);
+  ASSERT_NE(*model, nullptr) << error;
+}
+
+std::map<LandmarkId, Eigen::Vector2d> TrueLandmarks(
+    const Dataset& dataset, const Eigen::Vector2d& offset) {
+  std::map<LandmarkId, Eigen::Vector2d> landmarks;
+  for (const Landmark& l : dataset.ground_truth_landmarks) {
+    landmarks[l.id] = Eigen::Vector2d(l.x, l.y) + offset;
+  }
+  return landmarks;
+}
+
 // Sigmas stated 4x the noise drawn (a recording's guess): the noise scales
 // learned with Q_c bring range and bearing back to the drawn ones, and the
 // solve to the accuracy of the same data stated truthfully, whose scales
@@ -188,19 +209,14 @@ TEST(VarianceComponentsTest, ResidualsAtTheStatedSigmasUndoTheNoiseScales) {
   options.prior = "wnoa";
   options.problem.noise.range = 0.5;
   options.problem.noise.bearing = 4.0;
-  std::string error;
-  const std::shared_ptr<const MeanFunction> mean = BuildPriorMean(
-      "constant", dataset, options.localization, kPaperSplineSmoothing, &error);
-  ASSERT_NE(mean, nullptr) << error;
-  std::unique_ptr<TrajectoryModel> model =
-      CreateTrajectoryModel(dataset, options, mean, &error);
-  ASSERT_NE(model, nullptr) << error;
-  std::map<LandmarkId, Eigen::Vector2d> landmarks;
-  for (const Landmark& l : dataset.ground_truth_landmarks) {
-    landmarks[l.id] = Eigen::Vector2d(l.x + 0.3, l.y - 0.2);
-  }
+  std::unique_ptr<TrajectoryModel> model;
+  ModelAboutAConstantMean(dataset, options, &model);
+  ASSERT_NE(model, nullptr);
   SlamProblem problem(model.get(), options.problem);
-  ASSERT_TRUE(problem.Build(dataset, landmarks, &error)) << error;
+  std::string error;
+  ASSERT_TRUE(problem.Build(
+      dataset, TrueLandmarks(dataset, Eigen::Vector2d(0.3, -0.2)), &error))
+      << error;
   const auto scaled = problem.WhitenedResidualsByKind();
   const auto stated = problem.WhitenedResidualsByKind(/*stated_sigmas=*/true);
   ASSERT_EQ(scaled.size(), stated.size());
@@ -221,17 +237,12 @@ TEST(VarianceComponentsTest, ResidualsAtTheStatedSigmasUndoTheNoiseScales) {
 void ExpectRedundanciesMatchTheExactTraces(const SlamOptions& given) {
   const Dataset dataset = WnoaDraw(3, 40, 0.05, 0.01);
   SlamOptions options = given;
+  std::unique_ptr<TrajectoryModel> model;
+  ModelAboutAConstantMean(dataset, options, &model);
+  ASSERT_NE(model, nullptr);
+  const std::map<LandmarkId, Eigen::Vector2d> landmarks =
+      TrueLandmarks(dataset, Eigen::Vector2d::Zero());
   std::string error;
-  const std::shared_ptr<const MeanFunction> mean = BuildPriorMean(
-      "constant", dataset, options.localization, kPaperSplineSmoothing, &error);
-  ASSERT_NE(mean, nullptr) << error;
-  std::unique_ptr<TrajectoryModel> model =
-      CreateTrajectoryModel(dataset, options, mean, &error);
-  ASSERT_NE(model, nullptr) << error;
-  std::map<LandmarkId, Eigen::Vector2d> landmarks;
-  for (const Landmark& l : dataset.ground_truth_landmarks) {
-    landmarks[l.id] = Eigen::Vector2d(l.x, l.y);
-  }
   options.problem.loss = options.problem.odometry_loss = {"none", 1.0};
   SlamProblem problem(model.get(), options.problem);
   ASSERT_TRUE(problem.Build(dataset, landmarks, &error)) << error;
