@@ -73,13 +73,13 @@ mrclam() {
 }
 
 # The same robot stated as the ../shared heldout/ file is (loose sigmas:
-# range 0.15 m, bearing 0.05 rad, odometry 0.02 m and rad per step between
-# measurement times, first pose 0.05), its map priors 1 m off (seed 200 + N).
+# range 0.15 m, bearing 0.05 rad, odometry 0.02 m and rad per step of at
+# most 0.25 s, first pose 0.05), its map priors 1 m off (seed 200 + N).
 mrclam_as_shared() {
   local robot=$1 split=$2
   local name="mrclam6_robot${robot}_as_shared_map_1m_off"
   quietly "$build/rff_convert" --format=mrclam --input="$shared/mrclam6" \
-      --mrclam_robot="$robot" --mrclam_odometry_interval=0 \
+      --mrclam_robot="$robot" --mrclam_odometry_interval=0.25 \
       --mrclam_range_sigma=0.15 --mrclam_bearing_sigma=0.05 \
       --mrclam_odom_sigma_xy_floor=0.02 --mrclam_odom_sigma_theta_floor=0.02 \
       --mrclam_odom_sigma_theta_per_s=0 --prior_sigma_xy=0.05 \
