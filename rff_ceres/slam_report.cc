@@ -78,7 +78,11 @@ void PrintSlamSummary(const SlamOptions& options, const SlamResult& result,
   if (result.learning_rounds > 0) {
     *out << "  scales       " << (options.prior == "wnoa" ? "Q_c" : "variances")
          << " learned by variance components, " << result.learning_rounds
-         << " rounds\n";
+         << " rounds"
+         << (result.learning_converged
+                 ? ""
+                 : " (stopped at the round cap, the factors still moving)")
+         << "\n";
   }
   const NoiseScales& noise = result.noise;
   if (noise.range != 1.0 || noise.bearing != 1.0 || noise.odometry != 1.0) {
@@ -92,8 +96,9 @@ void PrintSlamSummary(const SlamOptions& options, const SlamResult& result,
             "fit exactly, the likelihood's degenerate edge)\n";
   }
   if (!result.scales_not_learned.empty()) {
-    *out << "  warning: the prior's scales were not learned: "
-         << result.scales_not_learned << "\n";
+    *out << "  warning: learning the scales stopped after "
+         << result.learning_rounds << " rounds: " << result.scales_not_learned
+         << "\n";
   }
   *out << "  problem      " << s.num_residual_blocks << " residual blocks, "
        << s.num_parameters << " parameters\n"
@@ -179,6 +184,8 @@ void WriteSummaryJson(const SlamOptions& options, const SlamResult& result,
       << ", " << FormatNumber(result.learning.level.y()) << ", "
       << FormatNumber(result.learning.level.z()) << "],\n"
       << "  \"learning_rounds\": " << result.learning_rounds << ",\n"
+      << "  \"learning_converged\": "
+      << (result.learning_converged ? "true" : "false") << ",\n"
       << "  \"scales_not_learned\": " << JsonString(result.scales_not_learned)
       << ",\n"
       << "  \"prior_scale_factors\": ["

@@ -662,6 +662,9 @@ constexpr int kMaxScaleRounds = 12;
 constexpr double kScaleTolerance = 0.1;
 constexpr double kMaxScaleStep = 10.0;  // Per round, either way.
 constexpr int kAcceleratingFalls = 3;
+// Noise sigmas stay within this factor of the stated ones: noise-free data
+// would drive them to 0 and the system to no digits.
+constexpr double kMaxNoiseScale = 1e3;
 bool LearnScales(const Dataset& dataset,
                  std::shared_ptr<const MeanFunction> mean,
                  const ceres::Solver::Options& ceres_options,
@@ -690,7 +693,7 @@ bool LearnScales(const Dataset& dataset,
       // Data that leave part of the run beyond double precision (a pose
       // after a gap of days): the scales stay as they are, and say so.
       result->scales_not_learned = why;
-      return true;
+      break;
     }
     double largest_step = 0.0;
     // `power` 1 for a variance, 0.5 for a sigma.
@@ -717,6 +720,9 @@ bool LearnScales(const Dataset& dataset,
       largest_step = std::max(largest_step, std::abs(std::log(c.factor)));
       *scale *= std::pow(
           std::clamp(c.factor, 1.0 / kMaxScaleStep, kMaxScaleStep), power);
+      if (power < 1.0) {
+        *scale = std::clamp(*scale, 1.0 / kMaxNoiseScale, kMaxNoiseScale);
+      }
     };
     rescale(VarianceGroup::kPriorPosition, 1.0, position_scale);
     rescale(VarianceGroup::kPriorHeading, 1.0, heading_scale);
@@ -736,7 +742,10 @@ bool LearnScales(const Dataset& dataset,
     result->prior_scale_factors
         << components[static_cast<int>(VarianceGroup::kPriorPosition)].factor,
         components[static_cast<int>(VarianceGroup::kPriorHeading)].factor;
-    if (largest_step < std::log1p(kScaleTolerance)) break;
+    if (largest_step < std::log1p(kScaleTolerance)) {
+      result->learning_converged = true;
+      break;
+    }
     // Q_c scales the WNOA prior only: its states stay as they are. RFF
     // features follow the variance (capacity): refit them to the estimate.
     const std::vector<double> blocks = ModelBlocks(**model);
@@ -918,6 +927,7 @@ bool RunSlamAtOrigin(const Dataset& dataset, const SlamOptions& options,
       settled.problem.odometry_loss.name = "none";
     }
     settled.problem.noise = wnoa.noise;  // Learned from the same data.
+    result->noise_kept = wnoa.noise_kept;
     if (wnoa_mean) {
       mean = std::make_shared<PiecewiseLinearMean>(wnoa.trajectory);
       wnoa_mean_solve = std::move(wnoa);

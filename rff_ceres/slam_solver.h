@@ -143,6 +143,8 @@ struct SlamResult {
   // Rounds of variance-component rescaling of the prior's scales, and the
   // last round's factors (position, heading): about 1 at the fixed point.
   int learning_rounds = 0;
+  // The last round's factors were all within 10% of 1 (not the round cap).
+  bool learning_converged = false;
   // Why the scales kept their values although learning was on (the
   // information matrix numerically singular); empty otherwise.
   std::string scales_not_learned;

@@ -155,6 +155,7 @@ TEST(VarianceComponentsTest, NoiseScalesFindSigmasStatedTooLoose) {
       std::string error;
       ASSERT_TRUE(RunSlam(dataset, options, &result, &error)) << error;
       EXPECT_TRUE(result.noise_kept.empty());
+      EXPECT_TRUE(result.learning_converged);
       Evaluation evaluation;
       ASSERT_TRUE(Evaluate(dataset.ground_truth, dataset.ground_truth_landmarks,
                            result.trajectory, nullptr, EvaluationOptions(),
@@ -188,16 +189,41 @@ TEST(VarianceComponentsTest, OdometrySigmaRunningToZeroKeepsTheStatedOne) {
     Dataset dataset;
     std::string error;
     ASSERT_TRUE(Simulate(sim, &dataset, &error)) << error;
-    SlamOptions options;
-    options.prior = "wnoa";
-    SlamResult result;
-    ASSERT_TRUE(RunSlam(dataset, options, &result, &error)) << error;
-    std::printf("seed %llu: range %.3f bearing %.3f odometry %.3f\n",
-                static_cast<unsigned long long>(seed), result.noise.range,
-                result.noise.bearing, result.noise.odometry);
-    EXPECT_EQ(result.noise_kept, std::vector<std::string>{"odometry"});
-    EXPECT_EQ(result.noise.odometry, 1.0);
+    // The RFF prior solves with (and reports) the scales of its WNOA mean.
+    for (const std::string prior : {"wnoa", "rff"}) {
+      SlamOptions options;
+      options.prior = prior;
+      SlamResult result;
+      ASSERT_TRUE(RunSlam(dataset, options, &result, &error)) << error;
+      std::printf("seed %llu %s: range %.3f bearing %.3f odometry %.3f\n",
+                  static_cast<unsigned long long>(seed), prior.c_str(),
+                  result.noise.range, result.noise.bearing,
+                  result.noise.odometry);
+      EXPECT_EQ(result.noise_kept, std::vector<std::string>{"odometry"});
+      EXPECT_EQ(result.noise.odometry, 1.0);
+    }
   }
+}
+
+// Noise-free data fit ever closer as their sigmas fall: the sigmas stop at
+// 1/1000 of the stated ones (the system keeps its digits), and the learning
+// says it did not converge.
+TEST(VarianceComponentsTest, NoiseFreeDataStopAtTheSigmaBound) {
+  SimulationOptions sim = PaperOptions(3);
+  sim.num_steps = 60;
+  sim.num_landmarks = 10;
+  sim.noise_free = true;
+  Dataset dataset;
+  std::string error;
+  ASSERT_TRUE(Simulate(sim, &dataset, &error)) << error;
+  SlamOptions options;
+  options.prior = "wnoa";
+  SlamResult result;
+  ASSERT_TRUE(RunSlam(dataset, options, &result, &error)) << error;
+  EXPECT_DOUBLE_EQ(result.noise.range, 1e-3);
+  EXPECT_DOUBLE_EQ(result.noise.bearing, 1e-3);
+  EXPECT_FALSE(result.learning_converged);
+  EXPECT_EQ(result.learning_rounds, 12);
 }
 
 // The problem solves with the noise-scaled sigmas; its residuals at the
