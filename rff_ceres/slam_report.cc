@@ -92,8 +92,8 @@ void PrintSlamSummary(const SlamOptions& options, const SlamResult& result,
   }
   for (const std::string& kind : result.noise_kept) {
     *out << "  noise        " << kind
-         << " sigma kept as stated: learning ran it towards 0 (its residuals "
-            "fit exactly, the likelihood's degenerate edge)\n";
+         << " sigma kept as stated: learning ran it towards 0, faster "
+            "each round\n";
   }
   if (!result.scales_not_learned.empty()) {
     *out << "  warning: learning the scales stopped after "
