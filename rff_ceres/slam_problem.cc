@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string_view>
 
 #include "Eigen/Eigenvalues"
 #include "costs/bearing_cost.h"
@@ -17,6 +18,35 @@
 #include "rff_ceres/option_error.h"
 
 namespace rff {
+namespace {
+
+// The variance group of row `row` of a residual block of data kind `kind`
+// (a range-bearing block is range, then bearing); kFixed for the priors.
+VarianceGroup DataRowGroup(std::string_view kind, int row) {
+  if (kind == "range" || (kind == "range-bearing" && row == 0)) {
+    return VarianceGroup::kRange;
+  }
+  if (kind == "bearing" || kind == "range-bearing") {
+    return VarianceGroup::kBearing;
+  }
+  return kind == "odometry" ? VarianceGroup::kOdometry : VarianceGroup::kFixed;
+}
+
+// The factor `noise` puts on the sigmas of `group`'s rows; 1 for the rest.
+double NoiseScale(const NoiseScales& noise, VarianceGroup group) {
+  switch (group) {
+    case VarianceGroup::kRange:
+      return noise.range;
+    case VarianceGroup::kBearing:
+      return noise.bearing;
+    case VarianceGroup::kOdometry:
+      return noise.odometry;
+    default:
+      return 1.0;
+  }
+}
+
+}  // namespace
 
 bool CreateLoss(const LossOptions& options, const std::string& flag,
                 std::unique_ptr<ceres::LossFunction>* loss,
@@ -300,16 +330,10 @@ std::map<std::string, std::vector<double>> SlamProblem::WhitenedResidualsByKind(
                                          &cost, residuals.data(), nullptr)) {
       continue;
     }
-    if (stated_sigmas) {
-      const std::string kind(name);
-      const NoiseScales& n = options_.noise;
-      for (std::size_t row = 0; row < residuals.size(); ++row) {
-        residuals[row] *=
-            kind == "odometry" ? n.odometry
-            : kind == "range" || (kind == "range-bearing" && row == 0) ? n.range
-            : kind == "bearing" || kind == "range-bearing" ? n.bearing
-                                                           : 1.0;
-      }
+    for (std::size_t row = 0; stated_sigmas && row < residuals.size();
+         ++row) {
+      residuals[row] *= NoiseScale(
+          options_.noise, DataRowGroup(name, static_cast<int>(row)));
     }
     std::vector<double>& kind = by_kind[name];
     kind.insert(kind.end(), residuals.begin(), residuals.end());
@@ -428,17 +452,8 @@ std::vector<VarianceGroup> SlamProblem::RowGroups(
       }
       continue;
     }
-    const std::string kind = source->second.kind;
     for (int row = 0; row < n; ++row) {
-      if (kind == "range" || (kind == "range-bearing" && row == 0)) {
-        rows.push_back(VarianceGroup::kRange);
-      } else if (kind == "bearing" || kind == "range-bearing") {
-        rows.push_back(VarianceGroup::kBearing);
-      } else if (kind == "odometry") {
-        rows.push_back(VarianceGroup::kOdometry);
-      } else {
-        rows.push_back(VarianceGroup::kFixed);
-      }
+      rows.push_back(DataRowGroup(source->second.kind, row));
     }
   }
   return rows;

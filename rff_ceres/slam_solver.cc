@@ -679,9 +679,14 @@ bool LearnScales(const Dataset& dataset,
   double* heading_scale = wnoa ? &settled->wnoa.heading_qc
                                : &settled->trajectory.heading_kernel.variance;
   NoiseScales& sigmas = settled->problem.noise;
+  // Per noise group: its last fall (-log factor) and the rounds in a row
+  // it fell by at least the round before's.
+  struct Falls {
+    double last = 0.0;
+    int accelerating = 0;
+  };
+  std::map<VarianceGroup, Falls> falls;
   std::set<VarianceGroup> kept;  // Noise sigmas back at the stated ones.
-  std::map<VarianceGroup, double> last_fall;  // -log factor.
-  std::map<VarianceGroup, int> accelerating_falls;
   ceres::Solver::Options placing_options = ceres_options;
   placing_options.function_tolerance =
       std::max(ceres_options.function_tolerance, kPlacingTolerance);
@@ -700,13 +705,11 @@ bool LearnScales(const Dataset& dataset,
     auto rescale = [&](VarianceGroup group, double power, double* scale) {
       const VarianceComponent& c = components[static_cast<int>(group)];
       if (!c.estimated || kept.count(group) > 0) return;
-      // Rounds in a row this scale fell by more than the round before.
       const double fall = -std::log(c.factor);
-      int& accelerating = accelerating_falls[group];
-      accelerating =
-          fall > 0.0 && fall >= last_fall[group] ? accelerating + 1 : 0;
-      last_fall[group] = fall;
-      if (power < 1.0 && accelerating > kAcceleratingFalls) {
+      Falls& f = falls[group];
+      f.accelerating = fall > 0.0 && fall >= f.last ? f.accelerating + 1 : 0;
+      f.last = fall;
+      if (power < 1.0 && f.accelerating > kAcceleratingFalls) {
         // A noise sigma falling faster round after round runs to the
         // likelihood's degenerate edge, its rows fit exactly as it goes to
         // 0 (a misfit prior lets them): back to the stated one. A real
@@ -1050,18 +1053,21 @@ bool RunSlamAtOrigin(const Dataset& dataset, const SlamOptions& options,
                          model.get(), &landmarks, initial_extent, &problem,
                          result, error)) {
     return false;
-  } else if (!(wnoa_learns || correction)) {
-    if (SettleAutoLosses(problem.get(), &settled.problem) &&
-        !SolveBatch(dataset, settled, ceres_options, model.get(), &landmarks,
-                    initial_extent, &problem, result, error)) {
+  } else {
+    // Finishes the judging solve: a learning round's solves come first.
+    const bool judged = SettleAutoLosses(problem.get(), &settled.problem);
+    if (wnoa_learns || correction) {
+      if (!LearnScales(dataset, mean, ceres_options, initial_extent,
+                       /*noise=*/wnoa_learns, /*loose=*/judged, &settled,
+                       &model, &landmarks, &problem, result, error)) {
+        return false;
+      }
+    } else if (judged &&
+               !SolveBatch(dataset, settled, ceres_options, model.get(),
+                           &landmarks, initial_extent, &problem, result,
+                           error)) {
       return false;
     }
-  } else if (!LearnScales(dataset, mean, ceres_options, initial_extent,
-                          /*noise=*/wnoa_learns,
-                          SettleAutoLosses(problem.get(), &settled.problem),
-                          &settled, &model, &landmarks, &problem, result,
-                          error)) {
-    return false;
   }
   result->noise = settled.problem.noise;
   // Incremental updates keep an "auto" loss robust throughout.
