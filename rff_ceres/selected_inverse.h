@@ -9,6 +9,10 @@
 // of L form a clique of it). The pattern holds that of H, so each diagonal
 // block and each pair of blocks that share a residual is available, at a
 // cost of sum_j nnz(L_:j)^2: linear in the length of a banded run.
+// Columns with one pattern below their diagonal block (a supernode J with
+// rows R, such as a parameter block) are done at once, with dense products:
+//
+//   Z_RJ = -Z_RR L_RJ L_JJ^-1,  Z_JJ = L_JJ^-T (L_JJ^-1 - L_RJ^T Z_RJ).
 #ifndef RFF_CERES_SELECTED_INVERSE_H_
 #define RFF_CERES_SELECTED_INVERSE_H_
 
@@ -31,14 +35,27 @@ class SelectedInverse {
   // computed pattern.
   bool Entry(int i, int j, double* value) const;
 
+  // Columns the last Compute() did in supernodes of two or more.
+  int supernode_columns() const { return supernode_columns_; }
+
  private:
   // Position of row `row` in column `column` of the factor's pattern, or -1.
   std::int64_t Find(int row, int column) const;
+  // Entries in column `column` of the factor's pattern.
+  std::int64_t Count(int column) const;
+  // The first column of the supernode that ends at column `last`.
+  int SupernodeStart(int last) const;
+  // Z on the pattern of column j, or of columns [first, end), from the
+  // factor's values `l` and the later columns of Z; false when an entry it
+  // needs is off the pattern or the result is not finite.
+  bool InvertColumn(int j, const double* l);
+  bool InvertSupernode(int first, int end, const double* l);
 
   std::vector<int> permutation_;  // Original index -> factor index.
   std::vector<std::int64_t> column_starts_;
   std::vector<int> rows_;  // Ascending within each column.
   std::vector<double> inverse_;
+  int supernode_columns_ = 0;
 };
 
 }  // namespace rff

@@ -1,5 +1,7 @@
 #include "rff_ceres/selected_inverse.h"
 
+#include <cmath>
+#include <limits>
 #include <random>
 #include <vector>
 
@@ -53,6 +55,59 @@ TEST(SelectedInverseTest, MatchesTheDenseInverseOnThePatternOfH) {
   EXPECT_FALSE(inverse.Entry(0, 40, &value));
   EXPECT_FALSE(inverse.Entry(-1, 0, &value));
   EXPECT_FALSE(inverse.Entry(0, 60, &value));
+}
+
+// H = J^T J + I for `blocks` parameter blocks of `width` columns, each row
+// touching two neighbouring blocks (an overlapping-window run) and one of
+// `dense` landmark columns: whole blocks share a pattern (supernodes).
+Eigen::SparseMatrix<double> BlockBanded(int blocks, int width, int dense,
+                                        unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> normal;
+  const int n = blocks * width + dense;
+  std::vector<Eigen::Triplet<double>> entries;
+  int row = 0;
+  for (int b = 0; b + 1 < blocks; ++b) {
+    for (int k = 0; k < 2 * width; ++k, ++row) {
+      for (int c = b * width; c < (b + 2) * width; ++c) {
+        entries.emplace_back(row, c, normal(rng));
+      }
+      entries.emplace_back(row, blocks * width + row % dense, normal(rng));
+    }
+  }
+  Eigen::SparseMatrix<double> jacobian(row, n);
+  jacobian.setFromTriplets(entries.begin(), entries.end());
+  Eigen::SparseMatrix<double> identity(n, n);
+  identity.setIdentity();
+  return Eigen::SparseMatrix<double>(jacobian.transpose() * jacobian) +
+         identity;
+}
+
+// Largest |Z_ij - (H^-1)_ij| over the pattern of H, relative to max |H^-1|.
+double WorstRelativeError(const Eigen::SparseMatrix<double>& h,
+                          const SelectedInverse& inverse) {
+  const Eigen::MatrixXd dense = Eigen::MatrixXd(h).ldlt().solve(
+      Eigen::MatrixXd::Identity(h.rows(), h.cols()));
+  double worst = 0.0;
+  for (int k = 0; k < h.outerSize(); ++k) {
+    for (Eigen::SparseMatrix<double>::InnerIterator it(h, k); it; ++it) {
+      double value = std::numeric_limits<double>::quiet_NaN();
+      if (!inverse.Entry(it.row(), it.col(), &value)) return 1.0;
+      worst = std::max(worst, std::abs(value - dense(it.row(), it.col())));
+    }
+  }
+  return worst / dense.cwiseAbs().maxCoeff();
+}
+
+TEST(SelectedInverseTest, SupernodesOfWholeBlocksMatchTheDenseInverse) {
+  for (const int width : {1, 6, 40}) {
+    const Eigen::SparseMatrix<double> h = BlockBanded(7, width, 4, width);
+    SelectedInverse inverse;
+    ASSERT_TRUE(inverse.Compute(h, 1 << 22)) << "width " << width;
+    EXPECT_LT(WorstRelativeError(h, inverse), 1e-12) << "width " << width;
+    // Each block of a wider run is (within) one supernode.
+    EXPECT_GE(inverse.supernode_columns(), 7 * (width - 1));
+  }
 }
 
 TEST(SelectedInverseTest, RefusesIndefiniteAndTooLargeFactors) {
