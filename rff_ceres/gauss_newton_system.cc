@@ -84,10 +84,12 @@ bool SchurFormFits(int t, Eigen::Index m) {
 }
 
 GaussNewtonSystem::GaussNewtonSystem(const RowMajorSparse& jacobian, int t,
-                                     bool sparse_fallback) {
+                                     Factorization factorization) {
   // A Schur complement singular to rounding is retried as the sparse LDLT
   // (solves only), as is a system without the form.
-  if (SchurFormFits(t, jacobian.cols() - t) && FormSchur(jacobian, t) &&
+  const bool sparse_fallback = factorization != Factorization::kSchurOnly;
+  if (factorization != Factorization::kSparse &&
+      SchurFormFits(t, jacobian.cols() - t) && FormSchur(jacobian, t) &&
       (positive_definite_ || !sparse_fallback)) {
     structured_ = true;
     return;

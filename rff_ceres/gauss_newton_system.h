@@ -38,13 +38,25 @@ std::vector<double*> LandmarksLast(SlamProblem* problem, int* num_leading);
 // only; the structure and conditioning are checked on the Jacobian).
 bool SchurFormFits(int t, Eigen::Index m);
 
+// How a GaussNewtonSystem is factorised.
+enum class Factorization {
+  // The Schur form where it fits (covariances available), else the sparse
+  // LDLT.
+  kSchurOrSparse,
+  // The Schur form only; a system without it is left unfactorised
+  // (positive_definite() false).
+  kSchurOnly,
+  // The sparse LDLT (solves only): for banded states (WNOA), whose dense
+  // Schur complement would cost t^3 / 3 for what a band does in O(t).
+  kSparse,
+};
+
 class GaussNewtonSystem {
  public:
   // `jacobian`'s first `t` columns are the leading blocks, the rest the
-  // landmarks, two each. Without `sparse_fallback` a system that has not
-  // the Schur form is left unfactorised (positive_definite() false).
+  // landmarks, two each.
   GaussNewtonSystem(const RowMajorSparse& jacobian, int t,
-                    bool sparse_fallback = true);
+                    Factorization factorization);
 
   // Whether the Schur form was built (covariances are available).
   bool structured() const { return structured_; }

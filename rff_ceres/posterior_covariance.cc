@@ -118,7 +118,7 @@ bool SchurCovariance(SlamProblem* problem, const TrajectoryModel& model,
   // Not structured or not positive definite: the QR of J (Ceres) decides,
   // and names the landmarks the data leave free.
   const GaussNewtonSystem system(linearized.jacobian, t,
-                                 /*sparse_fallback=*/false);
+                                 Factorization::kSchurOnly);
   if (!system.structured() || !system.positive_definite()) return false;
   const Eigen::MatrixXd leading = system.LeadingCovariance();
   for (const auto& [a, b] : block_pairs) {

@@ -152,6 +152,7 @@ class SlamProblem {
   void AddObservation(const Observation& observation);
 
   ceres::Problem* problem() { return problem_.get(); }
+  const TrajectoryModel& model() const { return *model_; }
   // (scale, offset) of the range sensor: (1, 0) unless estimated. Set it
   // before Begin() to start from another value.
   const Eigen::Vector2d& range_calibration() const {

@@ -67,7 +67,12 @@ bool EstimateVarianceComponents(SlamProblem* problem,
   }
   const std::vector<VarianceGroup> groups = problem->RowGroups(ids);
   CHECK_EQ(static_cast<Eigen::Index>(groups.size()), residuals.size());
-  const GaussNewtonSystem hessian(jacobian, num_leading);
+  // Only traces and solves are needed: banded states skip the dense Schur
+  // complement their solver does without too (AutoLinearSolverType).
+  const GaussNewtonSystem hessian(jacobian, num_leading,
+                                  problem->model().HasDenseReducedSystem()
+                                      ? Factorization::kSchurOrSparse
+                                      : Factorization::kSparse);
   if (!hessian.positive_definite()) {
     *error = "the Gauss-Newton Hessian is not positive definite";
     return false;

@@ -1,0 +1,68 @@
+#include "rff_ceres/gauss_newton_system.h"
+
+#include <random>
+#include <vector>
+
+#include "gtest/gtest.h"
+
+namespace rff {
+namespace {
+
+// A Jacobian of `t` chained leading columns and `landmarks` landmark pairs,
+// every row touching two neighbouring leading columns and one landmark.
+RowMajorSparse ChainWithLandmarks(int t, int landmarks, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> normal;
+  std::vector<Eigen::Triplet<double>> entries;
+  int row = 0;
+  for (int i = 0; i + 1 < t; ++i) {
+    for (int k = 0; k < 3; ++k, ++row) {
+      entries.emplace_back(row, i, normal(rng));
+      entries.emplace_back(row, i + 1, normal(rng));
+      const int landmark = t + 2 * (row % landmarks);
+      entries.emplace_back(row, landmark, normal(rng));
+      entries.emplace_back(row, landmark + 1, normal(rng));
+    }
+  }
+  RowMajorSparse jacobian(row, t + 2 * landmarks);
+  jacobian.setFromTriplets(entries.begin(), entries.end());
+  return jacobian;
+}
+
+TEST(GaussNewtonSystemTest, EveryFactorizationSolvesTheSameSystem) {
+  const int t = 40;
+  const RowMajorSparse jacobian = ChainWithLandmarks(t, 3, 7);
+  const GaussNewtonSystem schur(jacobian, t, Factorization::kSchurOrSparse);
+  const GaussNewtonSystem schur_only(jacobian, t, Factorization::kSchurOnly);
+  const GaussNewtonSystem sparse(jacobian, t, Factorization::kSparse);
+  ASSERT_TRUE(schur.positive_definite());
+  ASSERT_TRUE(schur_only.positive_definite());
+  ASSERT_TRUE(sparse.positive_definite());
+  EXPECT_TRUE(schur.structured());
+  EXPECT_TRUE(schur_only.structured());
+  EXPECT_FALSE(sparse.structured());
+
+  const Eigen::MatrixXd h = Eigen::MatrixXd(
+      Eigen::SparseMatrix<double>(jacobian.transpose()) * jacobian);
+  const Eigen::VectorXd z = Eigen::VectorXd::LinSpaced(h.rows(), -1.0, 2.0);
+  const Eigen::VectorXd expected = h.ldlt().solve(z);
+  const double scale = expected.cwiseAbs().maxCoeff();
+  EXPECT_LT((schur.Solve(z) - expected).cwiseAbs().maxCoeff(), 1e-9 * scale);
+  EXPECT_LT((sparse.Solve(z) - expected).cwiseAbs().maxCoeff(), 1e-9 * scale);
+}
+
+TEST(GaussNewtonSystemTest, SchurOnlyLeavesASystemWithoutTheFormUnfactorised) {
+  // A row on two landmarks: not the Schur form.
+  const int t = 10;
+  RowMajorSparse jacobian = ChainWithLandmarks(t, 2, 8);
+  jacobian.coeffRef(0, t + 2) = 1.0;
+  const GaussNewtonSystem schur_only(jacobian, t, Factorization::kSchurOnly);
+  EXPECT_FALSE(schur_only.structured());
+  EXPECT_FALSE(schur_only.positive_definite());
+  const GaussNewtonSystem fallback(jacobian, t, Factorization::kSchurOrSparse);
+  EXPECT_FALSE(fallback.structured());
+  EXPECT_TRUE(fallback.positive_definite());
+}
+
+}  // namespace
+}  // namespace rff
