@@ -10,6 +10,7 @@
 #include "costs/calibrated_range_cost.h"
 #include "costs/diagonal_prior_cost.h"
 #include "costs/landmark_prior_cost.h"
+#include "costs/near_landmark_cost.h"
 #include "costs/odometry_cost.h"
 #include "costs/pose_prior_cost.h"
 #include "costs/range_bearing_cost.h"
@@ -100,6 +101,17 @@ void SlamProblem::AddObservation(const Observation& o) {
   std::vector<double*> blocks = LocalBlocks({&map}, landmark);
   const double sigma_range = options_.noise.range * o.sigma_range;
   const double sigma_bearing = options_.noise.bearing * o.sigma_bearing;
+  // Judged at the stated sigma: the form of a record stays fixed while its
+  // noise scales are learned.
+  if (o.type == ObservationType::kRangeBearing &&
+      o.range < kNearRangeSigmas * o.sigma_range) {
+    Remember(
+        problem_->AddResidualBlock(new NearLandmarkCost(std::move(map), o.range,
+                                                        o.bearing, sigma_range),
+                                   loss_.get(), blocks),
+        {"range", o.t, o.t, o.id, true});
+    return;
+  }
   ceres::CostFunction* cost = nullptr;
   switch (o.type) {
     case ObservationType::kRange:
