@@ -5,7 +5,6 @@
 #ifndef RFF_CERES_SLAM_SOLVER_H_
 #define RFF_CERES_SLAM_SOLVER_H_
 
-#include <functional>
 #include <map>
 #include <memory>
 #include <ostream>
