@@ -5,7 +5,6 @@
 #ifndef RFF_CERES_SLAM_SOLVER_H_
 #define RFF_CERES_SLAM_SOLVER_H_
 
-#include <functional>
 #include <map>
 #include <memory>
 #include <ostream>
@@ -14,6 +13,7 @@
 
 #include "Eigen/Core"
 #include "ceres/solver.h"
+#include "rff_ceres/ceres_solve.h"  // SolverOptions, ToCeresOptions.
 #include "rff_ceres/feature_trajectory.h"
 #include "rff_ceres/hyperparameter_learning.h"
 #include "rff_ceres/initialization.h"
@@ -24,33 +24,6 @@
 #include "rff_ceres/wnoa_trajectory.h"
 
 namespace rff {
-
-// Ceres solver settings, named as Ceres names them.
-struct SolverOptions {
-  // "auto" (chosen from the problem's structure, see slam_solver.cc) or a
-  // Ceres linear solver name.
-  std::string linear_solver = "auto";
-  std::string preconditioner = "auto";  // Or a Ceres preconditioner name.
-  std::string trust_region_strategy = "LEVENBERG_MARQUARDT";
-  // 1: reproducible to the bit; more threads sum in scheduling order.
-  int num_threads = 1;
-  int max_iterations = 100;
-  double function_tolerance = 1e-8;
-  double gradient_tolerance = 1e-10;
-  double parameter_tolerance = 1e-8;
-  bool log_progress = false;  // Ceres's per-iteration log (glog INFO).
-  // Asked before every Ceres iteration when set: true stops the solve, which
-  // then fails ("the solve failed: ..."). For a caller that is interrupted
-  // (a Python Ctrl-C) and cannot wait for the last iteration.
-  std::function<bool()> should_abort;
-  // Largest linear system a solve may form (GB; 0: half of the machine's
-  // memory): a larger one is refused before it is allocated.
-  double max_memory_gb = 0.0;
-};
-
-// Validates `options` and fills the Ceres options from it.
-bool ToCeresOptions(const SolverOptions& options,
-                    ceres::Solver::Options* ceres_options, std::string* error);
 
 // Incremental mode (the paper's Plaza protocol): measurements are fed in time
 // order and the problem is re-solved, warm-started, after every `every` new

@@ -1,0 +1,168 @@
+#include "rff_ceres/ceres_solve.h"
+
+#include <cmath>
+
+#include "ceres/types.h"
+#include "glog/logging.h"
+#include "rff_ceres/option_error.h"
+#include "rff_ceres/slam_solver.h"
+
+namespace rff {
+namespace {
+
+// The preconditioners a flag can choose (SUBSET cannot be set up from one).
+constexpr char kPreconditioners[] =
+    "auto, IDENTITY, JACOBI, SCHUR_JACOBI, CLUSTER_JACOBI or "
+    "CLUSTER_TRIDIAGONAL";
+
+}  // namespace
+
+bool ToCeresOptions(const SolverOptions& options,
+                    ceres::Solver::Options* ceres_options, std::string* error) {
+  // "auto" is settled per problem by ChooseLinearSolver; until then the
+  // sparse Cholesky, whose options are always valid.
+  std::string name = options.linear_solver == "auto" ? "SPARSE_NORMAL_CHOLESKY"
+                                                     : options.linear_solver;
+  if (!ceres::StringToLinearSolverType(name,
+                                       &ceres_options->linear_solver_type)) {
+    *error = OptionError("linear_solver", options.linear_solver,
+                         "unknown linear solver",
+                         "auto, DENSE_SCHUR, SPARSE_SCHUR, ITERATIVE_SCHUR, "
+                         "DENSE_QR, DENSE_NORMAL_CHOLESKY, "
+                         "SPARSE_NORMAL_CHOLESKY or CGNR");
+    return false;
+  }
+  // "auto": the preconditioner each iterative solver supports best.
+  name = options.preconditioner;
+  if (name == "auto") {
+    name = ceres_options->linear_solver_type == ceres::CGNR ? "JACOBI"
+                                                            : "SCHUR_JACOBI";
+  }
+  if (!ceres::StringToPreconditionerType(name,
+                                         &ceres_options->preconditioner_type)) {
+    *error = OptionError("preconditioner", options.preconditioner,
+                         "unknown preconditioner", kPreconditioners);
+    return false;
+  }
+  // SUBSET needs residual blocks chosen for it, which no flag can give.
+  if (ceres_options->preconditioner_type == ceres::SUBSET) {
+    *error = OptionError("preconditioner", options.preconditioner,
+                         "needs residual blocks chosen for it, which no flag "
+                         "gives",
+                         kPreconditioners);
+    return false;
+  }
+  // Ceres 2.1's CGNR aborts on any other preconditioner.
+  if (ceres_options->linear_solver_type == ceres::CGNR &&
+      ceres_options->preconditioner_type != ceres::IDENTITY &&
+      ceres_options->preconditioner_type != ceres::JACOBI) {
+    *error = OptionError("preconditioner", options.preconditioner,
+                         "--linear_solver=CGNR takes IDENTITY or JACOBI only",
+                         "auto, IDENTITY or JACOBI with CGNR");
+    return false;
+  }
+  name = options.trust_region_strategy;
+  if (!ceres::StringToTrustRegionStrategyType(
+          name, &ceres_options->trust_region_strategy_type)) {
+    *error = OptionError("trust_region_strategy", options.trust_region_strategy,
+                         "unknown trust region strategy",
+                         "LEVENBERG_MARQUARDT or DOGLEG");
+    return false;
+  }
+  for (const auto& [flag, count] :
+       {std::pair("num_threads", options.num_threads),
+        std::pair("max_iterations", options.max_iterations)}) {
+    if (count < 1) {
+      *error = OptionError(flag, std::to_string(count), "", "1 or more");
+      return false;
+    }
+  }
+  for (const auto& [flag, tolerance] :
+       {std::pair("function_tolerance", options.function_tolerance),
+        std::pair("gradient_tolerance", options.gradient_tolerance),
+        std::pair("parameter_tolerance", options.parameter_tolerance)}) {
+    if (!CheckNonNegativeOption(tolerance, flag, error)) return false;
+  }
+  ceres_options->num_threads = options.num_threads;
+  ceres_options->max_num_iterations = options.max_iterations;
+  ceres_options->function_tolerance = options.function_tolerance;
+  ceres_options->gradient_tolerance = options.gradient_tolerance;
+  ceres_options->parameter_tolerance = options.parameter_tolerance;
+  ceres_options->minimizer_progress_to_stdout = false;
+  ceres_options->logging_type = ceres::SILENT;
+  std::string why;
+  if (!ceres_options->IsValid(&why)) {
+    *error = "invalid solver options: " + why;
+    return false;
+  }
+  return true;
+}
+
+void ChooseLinearSolver(const SolverOptions& solver,
+                        const TrajectoryModel& model,
+                        ceres::Solver::Options* options, SlamResult* result) {
+  if (solver.linear_solver != "auto") {
+    result->linear_solver = solver.linear_solver;
+    result->linear_solver_reason = "as asked";
+    return;
+  }
+  int trajectory_parameters = 0;
+  for (int b = 0; b < model.num_blocks(); ++b) {
+    trajectory_parameters += model.block_size(b);
+  }
+  options->linear_solver_type = AutoLinearSolverType(model);
+  const bool dense = options->linear_solver_type == ceres::DENSE_SCHUR;
+  result->linear_solver =
+      ceres::LinearSolverTypeToString(options->linear_solver_type);
+  const std::string count =
+      std::to_string(trajectory_parameters) + " trajectory parameters";
+  result->linear_solver_reason =
+      dense ? count + " <= " + std::to_string(kMaxDenseReducedSystem) +
+                  ": the reduced system is small and dense"
+      : model.HasDenseReducedSystem()
+          ? count + " > " + std::to_string(kMaxDenseReducedSystem) +
+                ": sparse factorisation of the whole system"
+          : count +
+                " in banded states: sparse factorisation of the whole "
+                "system";
+}
+
+// Schur solvers eliminate the landmarks first. The others get no ordering:
+// their fill-reducing ordering (AMD) puts landmarks seen from the whole run
+// last, where eliminating them first would make the system dense (the WNOA
+// states of Plaza: 3500 states, 4 landmarks).
+void SetOrdering(SlamProblem* problem, ceres::Solver::Options* options) {
+  const ceres::LinearSolverType type = options->linear_solver_type;
+  if (type == ceres::DENSE_SCHUR || type == ceres::SPARSE_SCHUR ||
+      type == ceres::ITERATIVE_SCHUR) {
+    options->linear_solver_ordering = problem->Ordering();
+  } else {
+    options->linear_solver_ordering.reset();
+  }
+}
+
+bool CheckSolve(const ceres::Solver::Summary& summary, SlamProblem* problem,
+                std::string* error) {
+  if (summary.termination_type != ceres::FAILURE &&
+      summary.termination_type != ceres::USER_FAILURE &&
+      std::isfinite(summary.final_cost)) {
+    return true;
+  }
+  std::string culprit;
+  *error = "the solve failed: " + summary.message;
+  if (problem->FindNonFinite(&culprit)) *error += " (" + culprit + ")";
+  return false;
+}
+
+ceres::CallbackReturnType ProgressLogger::operator()(
+    const ceres::IterationSummary& s) {
+  LOG(INFO) << "iteration " << s.iteration << ": cost " << s.cost
+            << ", cost change " << s.cost_change << ", |gradient| "
+            << s.gradient_max_norm << ", |step| " << s.step_norm
+            << ", trust radius " << s.trust_region_radius << ", "
+            << (s.step_is_successful ? "accepted" : "rejected") << ", "
+            << s.cumulative_time_in_seconds << " s";
+  return ceres::SOLVER_CONTINUE;
+}
+
+}  // namespace rff

@@ -1,0 +1,180 @@
+#include "rff_ceres/scale_learning.h"
+
+#include <algorithm>
+#include <cmath>
+#include <initializer_list>
+#include <limits>
+#include <set>
+#include <vector>
+
+#include "glog/logging.h"
+#include "rff_ceres/batch_solver.h"
+#include "rff_ceres/initialization.h"
+#include "rff_ceres/quality_report.h"
+#include "rff_ceres/variance_components.h"
+
+namespace rff {
+namespace {
+
+// Solves whose result only places the next step (the judging of "auto"
+// losses, a round of learned scales) stop at this relative cost change: the
+// factors and outlier levels they feed are far coarser.
+constexpr double kPlacingTolerance = 1e-4;
+
+// The rounds of LearnScales and how far one may move a scale.
+constexpr int kMaxScaleRounds = 12;
+constexpr double kScaleTolerance = 0.1;
+constexpr double kMaxScaleStep = 10.0;  // Per round, either way.
+constexpr int kAcceleratingFalls = 3;
+// Noise sigmas stay within this factor of the stated ones: noise-free data
+// would drive them to 0 and the system to no digits.
+constexpr double kMaxNoiseScale = 1e3;
+
+// Whether either loss is still to be judged.
+bool HasAutoLoss(const ProblemOptions& options) {
+  return options.loss.name == "auto" || options.odometry_loss.name == "auto";
+}
+
+}  // namespace
+
+ceres::Solver::Options JudgingOptions(const ProblemOptions& options,
+                                      ceres::Solver::Options ceres_options) {
+  if (HasAutoLoss(options)) {
+    ceres_options.function_tolerance =
+        std::max(ceres_options.function_tolerance, kPlacingTolerance);
+  }
+  return ceres_options;
+}
+
+bool SettleAutoLosses(SlamProblem* problem, ProblemOptions* options) {
+  const std::map<std::string, std::vector<double>> residuals =
+      problem->WhitenedResidualsByKind();
+  auto clean = [&](std::initializer_list<const char*> kinds) {
+    for (const char* kind : kinds) {
+      const auto it = residuals.find(kind);
+      if (it == residuals.end()) continue;
+      const double level = OutlierLevel(static_cast<int>(it->second.size()));
+      for (const double r : it->second) {
+        if (!(std::abs(r) <= level)) return false;
+      }
+    }
+    return true;
+  };
+  const bool judged = HasAutoLoss(*options);
+  auto settle = [&](bool is_clean, LossOptions* loss) {
+    if (loss->name == "auto") loss->name = is_clean ? "none" : "cauchy";
+  };
+  settle(clean({"range", "bearing", "range-bearing"}), &options->loss);
+  settle(clean({"odometry"}), &options->odometry_loss);
+  return judged;
+}
+
+bool LearnScales(const Dataset& dataset,
+                 std::shared_ptr<const MeanFunction> mean,
+                 const ceres::Solver::Options& ceres_options,
+                 double initial_extent, bool noise, bool loose,
+                 SlamOptions* settled, std::unique_ptr<TrajectoryModel>* model,
+                 std::map<LandmarkId, Eigen::Vector2d>* landmarks,
+                 std::unique_ptr<SlamProblem>* problem, SlamResult* result,
+                 std::string* error) {
+  const bool wnoa = settled->prior == "wnoa";
+  double* position_scale = wnoa ? &settled->wnoa.position_qc
+                                : &settled->trajectory.position_kernel.variance;
+  double* heading_scale = wnoa ? &settled->wnoa.heading_qc
+                               : &settled->trajectory.heading_kernel.variance;
+  NoiseScales& sigmas = settled->problem.noise;
+  // Per noise group: its last fall (-log factor) and the rounds in a row
+  // it fell by at least the round before's.
+  struct Falls {
+    double last = 0.0;
+    int accelerating = 0;
+  };
+  std::map<VarianceGroup, Falls> falls;
+  std::set<VarianceGroup> kept;  // Noise sigmas back at the stated ones.
+  ceres::Solver::Options placing_options = ceres_options;
+  placing_options.function_tolerance =
+      std::max(ceres_options.function_tolerance, kPlacingTolerance);
+  for (int round = 0; round < kMaxScaleRounds; ++round) {
+    VarianceComponents components;
+    std::string why;
+    if (!EstimateVarianceComponents(problem->get(), VarianceComponentOptions(),
+                                    &components, &why)) {
+      // Data that leave part of the run beyond double precision (a pose
+      // after a gap of days): the scales stay as they are, and say so.
+      result->scales_not_learned = why;
+      break;
+    }
+    double largest_step = 0.0;
+    // `power` 1 for a variance, 0.5 for a sigma.
+    auto rescale = [&](VarianceGroup group, double power, double* scale) {
+      const VarianceComponent& c = components[static_cast<int>(group)];
+      if (!c.estimated || kept.count(group) > 0) return;
+      const double fall = -std::log(c.factor);
+      Falls& f = falls[group];
+      f.accelerating = fall > 0.0 && fall >= f.last ? f.accelerating + 1 : 0;
+      f.last = fall;
+      if (power < 1.0 && f.accelerating > kAcceleratingFalls) {
+        // A noise sigma falling faster round after round runs to the
+        // likelihood's degenerate edge, its rows fit exactly as it goes to
+        // 0 (a misfit prior lets them): back to the stated one. A real
+        // scale's falls slow down towards its fixed point.
+        *scale = 1.0;
+        kept.insert(group);
+        result->noise_kept.push_back(VarianceGroupName(group));
+        largest_step = std::numeric_limits<double>::infinity();
+        return;
+      }
+      largest_step = std::max(largest_step, std::abs(std::log(c.factor)));
+      *scale *= std::pow(
+          std::clamp(c.factor, 1.0 / kMaxScaleStep, kMaxScaleStep), power);
+      if (power < 1.0) {
+        *scale = std::clamp(*scale, 1.0 / kMaxNoiseScale, kMaxNoiseScale);
+      }
+    };
+    rescale(VarianceGroup::kPriorPosition, 1.0, position_scale);
+    rescale(VarianceGroup::kPriorHeading, 1.0, heading_scale);
+    if (noise) {
+      rescale(VarianceGroup::kRange, 0.5, &sigmas.range);
+      rescale(VarianceGroup::kBearing, 0.5, &sigmas.bearing);
+      rescale(VarianceGroup::kOdometry, 0.5, &sigmas.odometry);
+    }
+    VLOG(1)
+        << "scale round " << round << ": prior position factor "
+        << components[static_cast<int>(VarianceGroup::kPriorPosition)].factor
+        << ", heading factor "
+        << components[static_cast<int>(VarianceGroup::kPriorHeading)].factor
+        << "; sigma factors range " << sigmas.range << ", bearing "
+        << sigmas.bearing << ", odometry " << sigmas.odometry;
+    result->learning_rounds = round + 1;
+    result->prior_scale_factors
+        << components[static_cast<int>(VarianceGroup::kPriorPosition)].factor,
+        components[static_cast<int>(VarianceGroup::kPriorHeading)].factor;
+    if (largest_step < std::log1p(kScaleTolerance)) {
+      result->learning_converged = true;
+      break;
+    }
+    // Q_c scales the WNOA prior only: its states stay as they are. RFF
+    // features follow the variance (capacity): refit them to the estimate.
+    const std::vector<double> blocks = ModelBlocks(**model);
+    const std::vector<TimedPose> estimate = result->trajectory;
+    *model = CreateTrajectoryModel(dataset, *settled, mean, error);
+    if (!*model) return false;
+    if (wnoa) {
+      SetModelBlocks(blocks, model->get());
+    } else if (!FitModelToPoses(estimate, model->get(), error)) {
+      return false;
+    }
+    if (!SolveBatch(dataset, *settled, placing_options, model->get(), landmarks,
+                    initial_extent, problem, result, error)) {
+      return false;
+    }
+    result->learned = true;
+    loose = true;
+  }
+  // The rounds' solves only placed the next factors.
+  return !loose ||
+         SolveBatch(dataset, *settled, ceres_options, model->get(), landmarks,
+                    initial_extent, problem, result, error);
+}
+
+}  // namespace rff

@@ -1,0 +1,53 @@
+// The solves after the first batch MAP that settle what the options left
+// open: "auto" losses judged on the residuals, and the scales of the prior
+// and of the data's sigmas learned by variance components.
+#ifndef RFF_CERES_SCALE_LEARNING_H_
+#define RFF_CERES_SCALE_LEARNING_H_
+
+#include <map>
+#include <memory>
+#include <string>
+
+#include "Eigen/Core"
+#include "ceres/solver.h"
+#include "rff_ceres/mean/mean_function.h"
+#include "rff_ceres/slam_problem.h"
+#include "rff_ceres/slam_solver.h"
+#include "rff_ceres/trajectory_model.h"
+#include "rff_ceres/types.h"
+
+namespace rff {
+
+// The robust solve that judges "auto" losses stops at kPlacingTolerance: the
+// judgement compares residuals with an outlier level of several sigma; the
+// solve after it finishes.
+ceres::Solver::Options JudgingOptions(const ProblemOptions& options,
+                                      ceres::Solver::Options ceres_options);
+
+// Settles "auto" losses (slam_problem.h) after the robust solve that judges
+// them (JudgingOptions): a loss whose residual kinds all stay within the
+// outlier level of their count becomes "none", the rest "cauchy". Returns
+// whether any was "auto", so that the judging solve is to be finished.
+bool SettleAutoLosses(SlamProblem* problem, ProblemOptions* options);
+
+// Learns the scales of the trajectory prior (WNOA Q_c, RFF kernel
+// variances) of x, y and theta and, where `noise`, the factors on the sigmas
+// of range, bearing and odometry: after the first MAP, each round rescales
+// the variances by their variance-component factors (variance_components.h,
+// the fixed point of the Laplace evidence) and solves again from the current
+// estimate, until every factor is within kScaleTolerance of one. The data's
+// stated sigmas are often a guess: MRCLAM's bearings and odometry are
+// several times tighter than stated (docs/heldout.md). `loose`: the problem
+// was solved at kPlacingTolerance only.
+bool LearnScales(const Dataset& dataset,
+                 std::shared_ptr<const MeanFunction> mean,
+                 const ceres::Solver::Options& ceres_options,
+                 double initial_extent, bool noise, bool loose,
+                 SlamOptions* settled, std::unique_ptr<TrajectoryModel>* model,
+                 std::map<LandmarkId, Eigen::Vector2d>* landmarks,
+                 std::unique_ptr<SlamProblem>* problem, SlamResult* result,
+                 std::string* error);
+
+}  // namespace rff
+
+#endif  // RFF_CERES_SCALE_LEARNING_H_
