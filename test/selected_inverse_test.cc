@@ -11,6 +11,17 @@
 namespace rff {
 namespace {
 
+// J^T J + I for the J of `rows` x `n` with `entries`.
+Eigen::SparseMatrix<double> GramPlusIdentity(
+    const std::vector<Eigen::Triplet<double>>& entries, int rows, int n) {
+  Eigen::SparseMatrix<double> jacobian(rows, n);
+  jacobian.setFromTriplets(entries.begin(), entries.end());
+  Eigen::SparseMatrix<double> identity(n, n);
+  identity.setIdentity();
+  return Eigen::SparseMatrix<double>(jacobian.transpose() * jacobian) +
+         identity;
+}
+
 // H = J^T J + I for a J of chained pairs (a banded run) and `dense` columns
 // that every row touches (landmarks seen throughout).
 Eigen::SparseMatrix<double> BandedWithDenseColumns(int n, int dense,
@@ -24,12 +35,7 @@ Eigen::SparseMatrix<double> BandedWithDenseColumns(int n, int dense,
     entries.emplace_back(row, i + 1, normal(rng));
     entries.emplace_back(row, n - dense + row % dense, normal(rng));
   }
-  Eigen::SparseMatrix<double> jacobian(row, n);
-  jacobian.setFromTriplets(entries.begin(), entries.end());
-  Eigen::SparseMatrix<double> identity(n, n);
-  identity.setIdentity();
-  return Eigen::SparseMatrix<double>(jacobian.transpose() * jacobian) +
-         identity;
+  return GramPlusIdentity(entries, row, n);
 }
 
 TEST(SelectedInverseTest, MatchesTheDenseInverseOnThePatternOfH) {
@@ -75,12 +81,7 @@ Eigen::SparseMatrix<double> BlockBanded(int blocks, int width, int dense,
       entries.emplace_back(row, blocks * width + row % dense, normal(rng));
     }
   }
-  Eigen::SparseMatrix<double> jacobian(row, n);
-  jacobian.setFromTriplets(entries.begin(), entries.end());
-  Eigen::SparseMatrix<double> identity(n, n);
-  identity.setIdentity();
-  return Eigen::SparseMatrix<double>(jacobian.transpose() * jacobian) +
-         identity;
+  return GramPlusIdentity(entries, row, n);
 }
 
 // Largest |Z_ij - (H^-1)_ij| over the pattern of H, relative to max |H^-1|.

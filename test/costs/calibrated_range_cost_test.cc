@@ -16,8 +16,7 @@ struct CalibratedRangeAutoDiff {
   template <typename T>
   bool operator()(T const* const* p, T* r) const {
     const auto pose = PoseOf(map, p);
-    const T dx = p[landmark_block][0] - pose[0];
-    const T dy = p[landmark_block][1] - pose[1];
+    const auto [dx, dy] = testing::LandmarkOffset(pose, p[landmark_block]);
     const T* calibration = p[landmark_block + 1];
     r[0] = (calibration[0] * sqrt(dx * dx + dy * dy) + calibration[1] - range) /
            sigma;
@@ -75,8 +74,7 @@ struct CalibratedRangeBearingAutoDiff {
   bool operator()(T const* const* p, T* r) const {
     CalibratedRangeAutoDiff{map, range, sigma_range, landmark_block}(p, r);
     const auto pose = PoseOf(map, p);
-    const T dx = p[landmark_block][0] - pose[0];
-    const T dy = p[landmark_block][1] - pose[1];
+    const auto [dx, dy] = testing::LandmarkOffset(pose, p[landmark_block]);
     r[1] = testing::Wrap(T(atan2(dy, dx) - pose[2] - bearing)) / sigma_bearing;
     return true;
   }

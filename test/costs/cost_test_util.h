@@ -6,6 +6,7 @@
 
 #include <memory>
 #include <random>
+#include <utility>
 #include <vector>
 
 #include "Eigen/Core"
@@ -49,6 +50,13 @@ Eigen::Matrix<T, 3, 1> PoseOf(const PoseMap& map, T const* const* p) {
     }
   }
   return pose;
+}
+
+// The landmark's offset from the pose's position, (l_x - x, l_y - y).
+template <typename T>
+std::pair<T, T> LandmarkOffset(const Eigen::Matrix<T, 3, 1>& pose,
+                               const T* landmark) {
+  return {landmark[0] - pose[0], landmark[1] - pose[1]};
 }
 
 template <typename T>

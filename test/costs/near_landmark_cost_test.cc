@@ -14,8 +14,7 @@ struct NearLandmarkAutoDiff {
   template <typename T>
   bool operator()(T const* const* p, T* r) const {
     const auto pose = PoseOf(map, p);
-    const T dx = p[landmark_block][0] - pose[0];
-    const T dy = p[landmark_block][1] - pose[1];
+    const auto [dx, dy] = testing::LandmarkOffset(pose, p[landmark_block]);
     // The landmark in the robot's frame against the measured point.
     const T forward = cos(pose[2]) * dx + sin(pose[2]) * dy;
     const T left = -sin(pose[2]) * dx + cos(pose[2]) * dy;

@@ -15,8 +15,7 @@ struct RangeBearingAutoDiff {
   template <typename T>
   bool operator()(T const* const* p, T* r) const {
     const auto pose = PoseOf(map, p);
-    const T dx = p[landmark_block][0] - pose[0];
-    const T dy = p[landmark_block][1] - pose[1];
+    const auto [dx, dy] = testing::LandmarkOffset(pose, p[landmark_block]);
     r[0] = (sqrt(dx * dx + dy * dy) - range) / sigma_range;
     r[1] = Wrap(T(atan2(dy, dx) - pose[2] - bearing)) / sigma_bearing;
     return true;
