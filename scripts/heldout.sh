@@ -162,6 +162,8 @@ else
   mrclam_as_shared 5 score
   plaza_heading 90 score
   plaza_heading 180 score
+  cp "$root/data/plaza2.rffd" "$data/plaza2.rffd"
+  add plaza2 score plaza
   laser 2 score
   laser 3 score
   gp_draw 101 rbf 3 score
