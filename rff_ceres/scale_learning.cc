@@ -91,6 +91,7 @@ bool LearnScales(const Dataset& dataset,
   };
   std::map<VarianceGroup, Falls> falls;
   std::set<VarianceGroup> kept;  // Noise sigmas back at the stated ones.
+  std::set<VarianceGroup> learned;  // Noise factors the data estimated.
   ceres::Solver::Options placing_options = ceres_options;
   placing_options.function_tolerance =
       std::max(ceres_options.function_tolerance, kPlacingTolerance);
@@ -125,6 +126,7 @@ bool LearnScales(const Dataset& dataset,
         return;
       }
       largest_step = std::max(largest_step, std::abs(std::log(c.factor)));
+      if (power < 1.0) learned.insert(group);
       *scale *= std::pow(
           std::clamp(c.factor, 1.0 / kMaxScaleStep, kMaxScaleStep), power);
       if (power < 1.0) {
@@ -170,6 +172,11 @@ bool LearnScales(const Dataset& dataset,
     }
     result->learned = true;
     loose = true;
+  }
+  for (const VarianceGroup group : learned) {
+    if (kept.count(group) == 0) {
+      result->noise_learned.push_back(VarianceGroupName(group));
+    }
   }
   // The rounds' solves only placed the next factors.
   return !loose ||

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <functional>
+#include <map>
 #include <memory>
 #include <string>
 #include <utility>
@@ -84,11 +85,18 @@ void PrintSlamSummary(const SlamOptions& options, const SlamResult& result,
                  : " (stopped at the round cap, the factors still moving)")
          << "\n";
   }
-  const NoiseScales& noise = result.noise;
-  if (noise.range != 1.0 || noise.bearing != 1.0 || noise.odometry != 1.0) {
-    *out << "  noise        sigmas learned as the stated ones times: range "
-         << noise.range << ", bearing " << noise.bearing << ", odometry "
-         << noise.odometry << "\n";
+  if (!result.noise_learned.empty()) {
+    const std::map<std::string, double> factors = {
+        {"range", result.noise.range},
+        {"bearing", result.noise.bearing},
+        {"odometry", result.noise.odometry}};
+    *out << "  noise        sigmas learned as the stated ones times:";
+    const char* separator = " ";
+    for (const std::string& kind : result.noise_learned) {
+      *out << separator << kind << " " << factors.at(kind);
+      separator = ", ";
+    }
+    *out << "\n";
   }
   for (const std::string& kind : result.noise_kept) {
     *out << "  noise        " << kind
@@ -198,6 +206,8 @@ void WriteSummaryJson(const SlamOptions& options, const SlamResult& result,
       << "  \"noise_scale_odometry\": " << FormatNumber(result.noise.odometry)
       << ",\n"
       << "  \"noise_scales_kept\": " << JsonStringArray(result.noise_kept)
+      << ",\n"
+      << "  \"noise_scales_learned\": " << JsonStringArray(result.noise_learned)
       << ",\n"
       << "  \"learning_seconds\": " << FormatNumber(result.learning.seconds)
       << ",\n"

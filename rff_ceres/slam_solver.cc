@@ -284,6 +284,7 @@ std::shared_ptr<const MeanFunction> BuildMean(
     }
     settled->problem.noise = wnoa.noise;  // Learned from the same data.
     result->noise_kept = wnoa.noise_kept;
+    result->noise_learned = wnoa.noise_learned;
     if (wnoa_mean) {
       mean = std::make_shared<PiecewiseLinearMean>(wnoa.trajectory);
       *wnoa_mean_solve = std::move(wnoa);

@@ -127,6 +127,9 @@ struct SlamResult {
   NoiseScales noise;
   // Kinds whose learned sigma ran towards 0 and went back to the stated one.
   std::vector<std::string> noise_kept;
+  // Kinds whose factor the data estimated (others, such as the bearings of a
+  // range-only run, keep 1 because nothing measured them).
+  std::vector<std::string> noise_learned;
   // The linear solver used and why ("auto" settles on one per problem).
   std::string linear_solver;
   std::string linear_solver_reason;

@@ -4,6 +4,7 @@
 #include <map>
 #include <memory>
 #include <random>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -16,6 +17,7 @@
 #include "rff_ceres/mean/prior_mean.h"
 #include "rff_ceres/metrics.h"
 #include "rff_ceres/simulate.h"
+#include "rff_ceres/slam_report.h"
 #include "rff_ceres/slam_solver.h"
 
 namespace rff {
@@ -156,6 +158,8 @@ TEST(VarianceComponentsTest, NoiseScalesFindSigmasStatedTooLoose) {
       ASSERT_TRUE(RunSlam(dataset, options, &result, &error)) << error;
       EXPECT_TRUE(result.noise_kept.empty());
       EXPECT_TRUE(result.learning_converged);
+      EXPECT_EQ(result.noise_learned,
+                (std::vector<std::string>{"range", "bearing"}));
       Evaluation evaluation;
       ASSERT_TRUE(Evaluate(dataset.ground_truth, dataset.ground_truth_landmarks,
                            result.trajectory, nullptr, EvaluationOptions(),
@@ -201,6 +205,17 @@ TEST(VarianceComponentsTest, OdometrySigmaRunningToZeroKeepsTheStatedOne) {
                   result.noise.odometry);
       EXPECT_EQ(result.noise_kept, std::vector<std::string>{"odometry"});
       EXPECT_EQ(result.noise.odometry, 1.0);
+      // A kept sigma is not reported as learned, nor printed as a factor.
+      EXPECT_EQ(result.noise_learned,
+                (std::vector<std::string>{"range", "bearing"}));
+      std::ostringstream summary;
+      PrintSlamSummary(options, result, &summary);
+      EXPECT_NE(summary.str().find("sigmas learned as the stated ones times: "
+                                   "range "),
+                std::string::npos)
+          << summary.str();
+      EXPECT_EQ(summary.str().find("odometry 1\n"), std::string::npos)
+          << summary.str();
     }
   }
 }
