@@ -8,16 +8,9 @@
 #include "Eigen/SparseCholesky"
 
 namespace rff {
-namespace {
-
-// Largest number of rows below a supernode whose inverse block Z_RR is
-// gathered densely (r^2 doubles: 128 MiB); wider ones go column by column.
-constexpr int kMaxDenseRows = 4096;
-
-}  // namespace
-
 bool SelectedInverse::Compute(const Eigen::SparseMatrix<double>& h,
-                              std::int64_t max_factor_nonzeros) {
+                              std::int64_t max_factor_nonzeros,
+                              int max_dense_block) {
   permutation_.clear();
   column_starts_.clear();
   rows_.clear();
@@ -49,16 +42,17 @@ bool SelectedInverse::Compute(const Eigen::SparseMatrix<double>& h,
   inverse_.assign(rows_.size(), 0.0);
   bool ok = true;
   for (int last = n - 1; ok && last >= 0;) {
-    const int first = SupernodeStart(last);
+    // The last columns of a supernode are a supernode themselves.
+    const int first =
+        std::max(SupernodeStart(last), last + 1 - max_dense_block);
     const int below = static_cast<int>(Count(first)) - (last + 1 - first);
-    if (last > first && below <= kMaxDenseRows) {
+    if (last > first && below <= max_dense_block) {
       ok = InvertSupernode(first, last + 1, l);
       supernode_columns_ += last + 1 - first;
-      last = first - 1;
     } else {
-      ok = InvertColumn(last, l);
-      --last;
+      for (int j = last; ok && j >= first; --j) ok = InvertColumn(j, l);
     }
+    last = first - 1;
   }
   if (!ok) inverse_.clear();
   return ok;

@@ -27,9 +27,14 @@ class SelectedInverse {
  public:
   // Factorises `h` (symmetric; its lower triangle is read) and computes the
   // inverse on the factor's pattern. False when `h` is not positive definite
-  // or the factor has more than `max_factor_nonzeros` entries.
+  // or the factor has more than `max_factor_nonzeros` entries. Supernodes
+  // are done in pieces of at most `max_dense_block` columns, and column by
+  // column where more rows than that lie below them (the dense blocks Z_RR
+  // and L_JJ take r^2 and s^2 doubles: 128 MiB each at the default).
+  static constexpr int kMaxDenseBlock = 4096;
   bool Compute(const Eigen::SparseMatrix<double>& h,
-               std::int64_t max_factor_nonzeros);
+               std::int64_t max_factor_nonzeros,
+               int max_dense_block = kMaxDenseBlock);
 
   // (H^-1)_ij in the original order; false when (i, j) is outside the
   // computed pattern.

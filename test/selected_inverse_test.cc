@@ -111,6 +111,20 @@ TEST(SelectedInverseTest, SupernodesOfWholeBlocksMatchTheDenseInverse) {
   }
 }
 
+// Dense blocks capped at 3 rows and columns: supernodes are cut into
+// pieces, and those with more rows below go column by column; the same
+// inverse either way.
+TEST(SelectedInverseTest, CappedDenseBlocksGiveTheSameInverse) {
+  const Eigen::SparseMatrix<double> h = BlockBanded(6, 8, 4, 9);
+  SelectedInverse capped;
+  ASSERT_TRUE(capped.Compute(h, 1 << 22, 3));
+  EXPECT_LT(WorstRelativeError(h, capped), 1e-12);
+  SelectedInverse whole;
+  ASSERT_TRUE(whole.Compute(h, 1 << 22));
+  EXPECT_GT(whole.supernode_columns(), capped.supernode_columns());
+  EXPECT_GT(capped.supernode_columns(), 0);
+}
+
 TEST(SelectedInverseTest, RefusesIndefiniteAndTooLargeFactors) {
   Eigen::SparseMatrix<double> h = BandedWithDenseColumns(20, 2, 2);
   SelectedInverse inverse;
