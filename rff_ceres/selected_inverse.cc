@@ -91,7 +91,9 @@ bool SelectedInverse::InvertColumn(int j, const double* l) {
     sum += inverse_[q] * l[q];
   }
   inverse_[diagonal] = 1.0 / (l_jj * l_jj) - sum / l_jj;
-  return true;
+  // As InvertSupernode: a pivot without digits (1e-310) is a failure.
+  return std::all_of(inverse_.begin() + diagonal, inverse_.begin() + end,
+                     [](double v) { return std::isfinite(v); });
 }
 
 bool SelectedInverse::InvertSupernode(int first, int end, const double* l) {

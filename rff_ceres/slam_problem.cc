@@ -102,14 +102,15 @@ void SlamProblem::AddObservation(const Observation& o) {
   const double sigma_range = options_.noise.range * o.sigma_range;
   const double sigma_bearing = options_.noise.bearing * o.sigma_bearing;
   // Judged at the stated sigma: the form of a record stays fixed while its
-  // noise scales are learned.
+  // noise scales are learned. Its rows are a range's and a bearing's.
   if (o.type == ObservationType::kRangeBearing &&
-      o.range < kNearRangeSigmas * o.sigma_range) {
+      std::abs(o.range) < kNearRangeSigmas * o.sigma_range) {
     Remember(
-        problem_->AddResidualBlock(new NearLandmarkCost(std::move(map), o.range,
-                                                        o.bearing, sigma_range),
-                                   loss_.get(), blocks),
-        {"range", o.t, o.t, o.id, true});
+        problem_->AddResidualBlock(
+            new NearLandmarkCost(std::move(map), o.range, o.bearing,
+                                 sigma_range, sigma_bearing, o.sigma_range),
+            loss_.get(), blocks),
+        {"range-bearing", o.t, o.t, o.id, true});
     return;
   }
   ceres::CostFunction* cost = nullptr;

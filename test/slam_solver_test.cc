@@ -767,55 +767,32 @@ TEST(SlamSolverTest, ShouldAbortStopsTheSolve) {
   EXPECT_EQ(asked, 2);
 }
 
-// A landmark on the robot's path: at the pose where they meet, a bearing's
-// gradient (~ 1 / distance) has no digits. Records within two range sigmas
-// are the landmark's position in the robot's frame ("range" residuals of two
-// rows): the solve converges, and the covariance is found, under both
-// priors.
-TEST(SlamSolverTest, LandmarkOnThePathIsAPositionNotABearing) {
-  SimulationOptions sim = PaperOptions(31);
-  sim.num_landmarks = 20;
+// The paper's simulator crowded with landmarks (sigma_r = 1 m): some are
+// measured at a negative range, whose residual pulls the landmark onto the
+// pose. As bearings those records left J^T J with no digits and
+// --output_covariance failed ("the data do not fix the position of
+// landmark ..."); as positions along and across the ray it succeeds.
+TEST(SlamSolverTest, CrowdedLandmarksKeepTheirCovariance) {
+  SimulationOptions sim = PaperOptions(1);
+  sim.num_landmarks = 6000;
+  sim.num_steps = 10;
+  sim.observations_per_step = 120;
   Dataset dataset;
   std::string error;
   ASSERT_TRUE(Simulate(sim, &dataset, &error)) << error;
-  const TimedPose& met = dataset.ground_truth[150];
-  const LandmarkId id = 1000;
-  dataset.landmark_priors.push_back({id, met.x + 2.0, met.y - 1.0, 5.0});
-  dataset.ground_truth_landmarks.push_back({id, met.x, met.y});
   int near = 0;
-  for (int k = 140; k <= 160; ++k) {
-    const TimedPose& p = dataset.ground_truth[k];
-    const double range = std::hypot(met.x - p.x, met.y - p.y);
-    const double bearing = std::atan2(met.y - p.y, met.x - p.x) - p.theta;
-    dataset.observations.push_back({ObservationType::kRangeBearing, p.t, id,
-                                    range, bearing, sim.sigma_range,
-                                    sim.sigma_bearing});
-  }
-  // The simulated records count too (sigma_r = 1 m).
   for (const Observation& o : dataset.observations) {
-    near += o.range < 2.0 * o.sigma_range;
+    near += std::abs(o.range) < 2.0 * o.sigma_range;
   }
-  ASSERT_GE(near, 5);
-  std::stable_sort(
-      dataset.observations.begin(), dataset.observations.end(),
-      [](const Observation& a, const Observation& b) { return a.t < b.t; });
-  for (const std::string prior : {"rff", "wnoa"}) {
-    SlamOptions options = PaperSolverOptions();
-    options.prior = prior;
-    options.compute_covariance = true;
-    SlamResult result;
-    ASSERT_TRUE(RunSlam(dataset, options, &result, &error))
-        << prior << ": " << error;
-    EXPECT_TRUE(result.converged) << prior;
-    EXPECT_EQ(result.quality.verdict, "ok") << prior;
-    EXPECT_EQ(result.pose_covariances.size(), result.trajectory.size());
-    const auto range = std::find_if(
-        result.quality.kinds.begin(), result.quality.kinds.end(),
-        [](const ResidualKindQuality& k) { return k.kind == "range"; });
-    ASSERT_NE(range, result.quality.kinds.end()) << prior;
-    EXPECT_EQ(range->residuals, 2 * near) << prior;
-    EXPECT_LT(ApeTranslation(dataset, result), 0.6) << prior;
-  }
+  ASSERT_GT(near, 0);
+  SlamOptions options;  // The defaults, as rff_slam has them.
+  options.prior = "wnoa";
+  options.compute_covariance = true;
+  SlamResult result;
+  ASSERT_TRUE(RunSlam(dataset, options, &result, &error)) << error;
+  EXPECT_TRUE(result.converged);
+  EXPECT_EQ(result.quality.verdict, "ok");
+  EXPECT_EQ(result.pose_covariances.size(), result.trajectory.size());
 }
 
 TEST(SlamSolverTest, NothingToEstimateIsAnError) {
