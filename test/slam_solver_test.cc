@@ -26,6 +26,20 @@ SlamOptions PaperSolverOptions() {
   return testing::SyntheticRangeBearingOptions();
 }
 
+// The paper's simulator (seed `seed`) with `steps` poses, `landmarks`
+// landmarks and `per_step` observations per pose; empty if it fails.
+Dataset PaperDataset(std::uint64_t seed, int steps, int landmarks,
+                     int per_step) {
+  SimulationOptions sim = PaperOptions(seed);
+  sim.num_steps = steps;
+  sim.num_landmarks = landmarks;
+  sim.observations_per_step = per_step;
+  Dataset dataset;
+  std::string error;
+  EXPECT_TRUE(Simulate(sim, &dataset, &error)) << error;
+  return dataset;
+}
+
 double ApeTranslation(const Dataset& dataset, const SlamResult& result) {
   Evaluation evaluation;
   std::string error;
@@ -773,13 +787,9 @@ TEST(SlamSolverTest, ShouldAbortStopsTheSolve) {
 // --output_covariance failed ("the data do not fix the position of
 // landmark ..."); as positions along and across the ray it succeeds.
 TEST(SlamSolverTest, CrowdedLandmarksKeepTheirCovariance) {
-  SimulationOptions sim = PaperOptions(1);
-  sim.num_landmarks = 6000;
-  sim.num_steps = 10;
-  sim.observations_per_step = 120;
-  Dataset dataset;
+  const Dataset dataset = PaperDataset(1, 10, 6000, 120);
+  ASSERT_FALSE(dataset.observations.empty());
   std::string error;
-  ASSERT_TRUE(Simulate(sim, &dataset, &error)) << error;
   int near = 0;
   for (const Observation& o : dataset.observations) {
     near += std::abs(o.range) < 2.0 * o.sigma_range;
@@ -873,13 +883,9 @@ TEST(LinearSystemSizeTest, TooLargeDenseSystemIsRefusedAndAutoSolves) {
 // under the default memory limit (half of any machine below 230 GB), before
 // anything is solved, with the way out.
 TEST(LinearSystemSizeTest, SchurSolversAreRefusedWhenOneLandmarkIsSeenAlways) {
-  SimulationOptions sim = PaperOptions(7);
-  sim.num_steps = 20000;
-  sim.num_landmarks = 1;
-  sim.observations_per_step = 1;
-  Dataset dataset;
+  const Dataset dataset = PaperDataset(7, 20000, 1, 1);
+  ASSERT_FALSE(dataset.observations.empty());
   std::string error;
-  ASSERT_TRUE(Simulate(sim, &dataset, &error)) << error;
   SlamOptions options;
   options.prior = "wnoa";
   if (MemoryLimitBytes(options.solver.max_memory_gb) >= 115e9) {
