@@ -1,5 +1,5 @@
 // A landmark measured (range z_r, bearing z_b) so close to the robot that it
-// may lie on either side of it (|z_r| < kNearRangeSigmas sigma_r), as its
+// may lie on either side of it (z_r < kNearRangeSigmas sigma_r), as its
 // position in the robot's frame at time t, along and across the measured
 // ray u = (cos z_b, sin z_b):
 //
@@ -20,7 +20,8 @@
 
 namespace rff {
 
-// Range-bearing records with |range| below this many range sigmas are given
+// Range-bearing records with a range below this many range sigmas (any
+// negative one too: the sensor measured the landmark on itself) are given
 // as a NearLandmarkCost.
 inline constexpr double kNearRangeSigmas = 2.0;
 

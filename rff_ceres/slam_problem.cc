@@ -104,7 +104,7 @@ void SlamProblem::AddObservation(const Observation& o) {
   // Judged at the stated sigma: the form of a record stays fixed while its
   // noise scales are learned. Its rows are a range's and a bearing's.
   if (o.type == ObservationType::kRangeBearing &&
-      std::abs(o.range) < kNearRangeSigmas * o.sigma_range) {
+      o.range < kNearRangeSigmas * o.sigma_range) {
     Remember(
         problem_->AddResidualBlock(
             new NearLandmarkCost(std::move(map), o.range, o.bearing,
