@@ -14,11 +14,11 @@
 #include "rff_ceres/incremental_solver.h"
 #include "rff_ceres/initialization.h"
 #include "rff_ceres/landmark_init.h"
-#include "rff_ceres/mean/prior_mean.h"
 #include "rff_ceres/mean_rotation.h"
 #include "rff_ceres/option_error.h"
 #include "rff_ceres/posterior_covariance.h"
 #include "rff_ceres/scale_learning.h"
+#include "rff_ceres/solve_start.h"
 
 namespace rff {
 namespace {
@@ -97,22 +97,6 @@ std::unique_ptr<TrajectoryModel> CreateTrajectoryModel(
 
 namespace {
 
-// The WNOA solve the RFF prior starts from: a batch solve of its own with
-// the same problem options, with its covariance when `covariance`.
-bool SolveWnoa(const Dataset& dataset, const SlamOptions& options,
-               bool covariance, SlamResult* solve, std::string* error) {
-  SlamOptions wnoa = options;
-  wnoa.prior = "wnoa";
-  wnoa.prior_mean = "auto";
-  wnoa.outer_rounds = 0;
-  wnoa.compute_covariance = covariance;
-  // The user's linear solver is for the RFF solve; banded states want their
-  // own (AutoLinearSolverType).
-  wnoa.solver.linear_solver = "auto";
-  wnoa.solver.preconditioner = "auto";
-  return RunSlam(dataset, wnoa, solve, error);
-}
-
 // What the quality report needs from the solve besides the residuals.
 SolveFacts SolveFactsOf(const SlamOptions& options, const SlamResult& result) {
   SolveFacts facts;
@@ -132,47 +116,6 @@ SolveFacts SolveFactsOf(const SlamOptions& options, const SlamResult& result) {
       result.odometry_calibration.minCoeff() < kMinOdometryScale + kAtBound ||
       result.odometry_calibration.maxCoeff() > kMaxOdometryScale - kAtBound;
   return facts;
-}
-
-// The blocks start (initial_trajectory "auto") at dead reckoning about a
-// constant mean with odometry, else at the fit of the pilot trajectory when
-// there is one, else at zero (the prior mean). A "wnoa" mean is already a
-// solve of the data: it is the start.
-bool InitializeBlocks(const Dataset& start, const SlamOptions& options,
-                      TrajectoryModel* model, SlamResult* result,
-                      std::string* error) {
-  result->initial_trajectory = "mean";
-  if (!options.initial_poses.empty()) {
-    result->initial_trajectory = "given";
-    return FitModelToPoses(options.initial_poses, model, error);
-  }
-  if (options.initial_trajectory == "mean" || result->prior_mean == "wnoa") {
-    return true;
-  }
-  if (result->prior_mean == "constant" && options.problem.use_odometry &&
-      !start.odometry.empty()) {
-    // Dead reckoning from the resolved start threads stretches without
-    // observations, where a localisation has nothing to go on.
-    DeadReckoningResult dead_reckoning;
-    DeadReckoningOptions through_gaps;
-    through_gaps.hold_through_gaps = true;
-    if (!DeadReckon(start, through_gaps, &dead_reckoning, error) ||
-        !FitModelToPoses(dead_reckoning.poses, model, error)) {
-      return false;
-    }
-    result->initial_trajectory = "dead reckoning";
-    return true;
-  }
-  std::vector<TimedPose> pilot;
-  std::string why;
-  if (!BuildPilotTrajectory(start, options.localization, OutputTimes(start),
-                            &pilot, &why)) {
-    VLOG(1) << "no pilot trajectory, starting from the mean: " << why;
-    return true;
-  }
-  if (!FitModelToPoses(pilot, model, error)) return false;
-  result->initial_trajectory = "localization";
-  return true;
 }
 
 // Adds the covariance of a mean that is itself an estimate (the WNOA
@@ -255,70 +198,6 @@ bool CheckData(const Dataset& dataset, const SlamOptions& options,
     }
   }
   return true;
-}
-
-// The prior mean. The RFF prior starts from a WNOA solve: as its mean with
-// a "wnoa" mean (kept in `wnoa_mean_solve`); as its initial value (`warm`)
-// without odometry, where the localisation pilot has no motion model to
-// bridge gaps between fixes.
-std::shared_ptr<const MeanFunction> BuildMean(
-    const Dataset& dataset, const Dataset& resolved, const SlamOptions& options,
-    SlamOptions* warm, SlamOptions* settled, SlamResult* wnoa_mean_solve,
-    SlamResult* result, std::string* error) {
-  std::shared_ptr<const MeanFunction> mean;
-  if (options.prior == "rff" && options.incremental.every == 0 &&
-      (result->prior_mean == "wnoa" ||
-       (dataset.odometry.empty() && options.initial_trajectory == "auto" &&
-        options.initial_poses.empty()))) {
-    SlamResult wnoa;
-    const bool wnoa_mean = result->prior_mean == "wnoa";
-    if (!SolveWnoa(dataset, options, wnoa_mean && options.compute_covariance,
-                   &wnoa, error)) {
-      return nullptr;
-    }
-    // The same data: a loss the WNOA solve found no outlier for is dropped
-    // here too. Its outliers may be its own misfit: the RFF solve decides.
-    if (wnoa.loss == "none") settled->problem.loss.name = "none";
-    if (wnoa.odometry_loss == "none") {
-      settled->problem.odometry_loss.name = "none";
-    }
-    settled->problem.noise = wnoa.noise;  // Learned from the same data.
-    result->noise_kept = wnoa.noise_kept;
-    result->noise_learned = wnoa.noise_learned;
-    if (wnoa_mean) {
-      mean = std::make_shared<PiecewiseLinearMean>(wnoa.trajectory);
-      *wnoa_mean_solve = std::move(wnoa);
-    } else {
-      warm->initial_poses = wnoa.trajectory;
-      for (const Landmark& l : wnoa.landmarks) {
-        warm->initial_landmarks[l.id] = Eigen::Vector2d(l.x, l.y);
-      }
-    }
-  }
-  if (!mean) {
-    mean = BuildPriorMean(result->prior_mean, resolved, options.localization,
-                          options.spline_smoothing, error);
-  }
-  return mean;
-}
-
-// The scale of the initial scene: the initial trajectory, the landmarks'
-// initial positions and the longest range, to tell a run-away solution from
-// a large scene.
-double InitialExtent(const Dataset& dataset,
-                     const std::vector<TimedPose>& initial,
-                     const std::map<LandmarkId, Eigen::Vector2d>& landmarks) {
-  double initial_extent = Extent(initial, landmarks);
-  for (const LandmarkPrior& p : dataset.landmark_priors) {
-    initial_extent = std::max(initial_extent, std::hypot(p.x, p.y));
-  }
-  double longest_range = 0.0;
-  for (const Observation& o : dataset.observations) {
-    if (o.HasRange()) {
-      longest_range = std::max(longest_range, std::abs(o.range));
-    }
-  }
-  return initial_extent + longest_range;
 }
 
 // Fills `result` from the solved problem: the losses and models as
