@@ -35,15 +35,18 @@ bool HasAutoLoss(const ProblemOptions& options) {
   return options.loss.name == "auto" || options.odometry_loss.name == "auto";
 }
 
+// `ceres_options` stopped at kPlacingTolerance at the latest.
+ceres::Solver::Options PlacingOptions(ceres::Solver::Options ceres_options) {
+  ceres_options.function_tolerance =
+      std::max(ceres_options.function_tolerance, kPlacingTolerance);
+  return ceres_options;
+}
+
 }  // namespace
 
 ceres::Solver::Options JudgingOptions(const ProblemOptions& options,
                                       ceres::Solver::Options ceres_options) {
-  if (HasAutoLoss(options)) {
-    ceres_options.function_tolerance =
-        std::max(ceres_options.function_tolerance, kPlacingTolerance);
-  }
-  return ceres_options;
+  return HasAutoLoss(options) ? PlacingOptions(ceres_options) : ceres_options;
 }
 
 bool SettleAutoLosses(SlamProblem* problem, ProblemOptions* options) {
@@ -92,9 +95,7 @@ bool LearnScales(const Dataset& dataset,
   std::map<VarianceGroup, Falls> falls;
   std::set<VarianceGroup> kept;  // Noise sigmas back at the stated ones.
   std::set<VarianceGroup> learned;  // Noise factors the data estimated.
-  ceres::Solver::Options placing_options = ceres_options;
-  placing_options.function_tolerance =
-      std::max(ceres_options.function_tolerance, kPlacingTolerance);
+  const ceres::Solver::Options placing_options = PlacingOptions(ceres_options);
   for (int round = 0; round < kMaxScaleRounds; ++round) {
     VarianceComponents components;
     std::string why;
@@ -126,11 +127,11 @@ bool LearnScales(const Dataset& dataset,
         return;
       }
       largest_step = std::max(largest_step, std::abs(std::log(c.factor)));
-      if (power < 1.0) learned.insert(group);
       *scale *= std::pow(
           std::clamp(c.factor, 1.0 / kMaxScaleStep, kMaxScaleStep), power);
       if (power < 1.0) {
         *scale = std::clamp(*scale, 1.0 / kMaxNoiseScale, kMaxNoiseScale);
+        learned.insert(group);
       }
     };
     rescale(VarianceGroup::kPriorPosition, 1.0, position_scale);

@@ -8,6 +8,7 @@
 #include "Eigen/SparseCholesky"
 
 namespace rff {
+
 bool SelectedInverse::Compute(const Eigen::SparseMatrix<double>& h,
                               std::int64_t max_factor_nonzeros,
                               int max_dense_block) {
@@ -43,8 +44,7 @@ bool SelectedInverse::Compute(const Eigen::SparseMatrix<double>& h,
   bool ok = true;
   for (int last = n - 1; ok && last >= 0;) {
     // The last columns of a supernode are a supernode themselves.
-    const int first =
-        std::max(SupernodeStart(last), last + 1 - max_dense_block);
+    const int first = SupernodeStart(last, last + 1 - max_dense_block);
     const int below = static_cast<int>(Count(first)) - (last + 1 - first);
     if (last > first && below <= max_dense_block) {
       ok = InvertSupernode(first, last + 1, l);
@@ -58,11 +58,11 @@ bool SelectedInverse::Compute(const Eigen::SparseMatrix<double>& h,
   return ok;
 }
 
-int SelectedInverse::SupernodeStart(int last) const {
+int SelectedInverse::SupernodeStart(int last, int lowest) const {
   // Column j - 1 joins column j's supernode when its pattern is {j - 1}
   // followed by column j's.
   int first = last;
-  while (first > 0 && Count(first - 1) == Count(first) + 1 &&
+  while (first > std::max(lowest, 0) && Count(first - 1) == Count(first) + 1 &&
          std::equal(rows_.begin() + column_starts_[first],
                     rows_.begin() + column_starts_[first + 1],
                     rows_.begin() + column_starts_[first - 1] + 1)) {

@@ -48,8 +48,9 @@ class SelectedInverse {
   std::int64_t Find(int row, int column) const;
   // Entries in column `column` of the factor's pattern.
   std::int64_t Count(int column) const;
-  // The first column of the supernode that ends at column `last`.
-  int SupernodeStart(int last) const;
+  // The first column of the supernode that ends at column `last`, or
+  // `lowest` if that is later.
+  int SupernodeStart(int last, int lowest) const;
   // Z on the pattern of column j, or of columns [first, end), from the
   // factor's values `l` and the later columns of Z; false when an entry it
   // needs is off the pattern or the result is not finite.

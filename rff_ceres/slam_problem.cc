@@ -19,10 +19,7 @@
 #include "rff_ceres/option_error.h"
 
 namespace rff {
-namespace {
 
-// The variance group of row `row` of a residual block of data kind `kind`
-// (a range-bearing block is range, then bearing); kFixed for the priors.
 VarianceGroup DataRowGroup(std::string_view kind, int row) {
   if (kind == "range" || (kind == "range-bearing" && row == 0)) {
     return VarianceGroup::kRange;
@@ -33,7 +30,6 @@ VarianceGroup DataRowGroup(std::string_view kind, int row) {
   return kind == "odometry" ? VarianceGroup::kOdometry : VarianceGroup::kFixed;
 }
 
-// The factor `noise` puts on the sigmas of `group`'s rows; 1 for the rest.
 double NoiseScale(const NoiseScales& noise, VarianceGroup group) {
   switch (group) {
     case VarianceGroup::kRange:
@@ -46,8 +42,6 @@ double NoiseScale(const NoiseScales& noise, VarianceGroup group) {
       return 1.0;
   }
 }
-
-}  // namespace
 
 bool CreateLoss(const LossOptions& options, const std::string& flag,
                 std::unique_ptr<ceres::LossFunction>* loss,
@@ -101,18 +95,6 @@ void SlamProblem::AddObservation(const Observation& o) {
   std::vector<double*> blocks = LocalBlocks({&map}, landmark);
   const double sigma_range = options_.noise.range * o.sigma_range;
   const double sigma_bearing = options_.noise.bearing * o.sigma_bearing;
-  // Judged at the stated sigma: the form of a record stays fixed while its
-  // noise scales are learned. Its rows are a range's and a bearing's.
-  if (o.type == ObservationType::kRangeBearing &&
-      o.range < kNearRangeSigmas * o.sigma_range) {
-    Remember(
-        problem_->AddResidualBlock(
-            new NearLandmarkCost(std::move(map), o.range, o.bearing,
-                                 sigma_range, sigma_bearing, o.sigma_range),
-            loss_.get(), blocks),
-        {"range-bearing", o.t, o.t, o.id, true});
-    return;
-  }
   ceres::CostFunction* cost = nullptr;
   switch (o.type) {
     case ObservationType::kRange:
@@ -127,7 +109,12 @@ void SlamProblem::AddObservation(const Observation& o) {
       cost = new BearingCost(std::move(map), o.bearing, sigma_bearing);
       break;
     case ObservationType::kRangeBearing:
-      if (options_.range_calibration.estimate) {
+      // Nearness is judged at the stated sigma: the form of a record stays
+      // fixed while its noise scales are learned.
+      if (o.range < kNearRangeSigmas * o.sigma_range) {
+        cost = new NearLandmarkCost(std::move(map), o.range, o.bearing,
+                                    sigma_range, sigma_bearing, o.sigma_range);
+      } else if (options_.range_calibration.estimate) {
         blocks.push_back(range_calibration_.data());
         cost = new CalibratedRangeBearingCost(
             std::move(map), o.range, o.bearing, sigma_range, sigma_bearing);

@@ -10,6 +10,7 @@
 #include <memory>
 #include <set>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "Eigen/Core"
@@ -87,6 +88,14 @@ enum class VarianceGroup {
   kPriorHeading
 };
 inline constexpr int kNumVarianceGroups = 6;
+
+// The variance group of row `row` of a residual block of data kind `kind`
+// (a range-bearing block is range, then bearing); kFixed for the priors.
+// For a kind name alone ("range", "bearing", "odometry"), row 0.
+VarianceGroup DataRowGroup(std::string_view kind, int row);
+
+// The factor `noise` puts on the sigmas of `group`'s rows; 1 for the rest.
+double NoiseScale(const NoiseScales& noise, VarianceGroup group);
 
 // Robust by default: real recordings carry outliers and heavy tails
 // (MRCLAM's commanded velocities, wrong associations); "auto" then drops the

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <functional>
-#include <map>
 #include <memory>
 #include <string>
 #include <utility>
@@ -86,14 +85,11 @@ void PrintSlamSummary(const SlamOptions& options, const SlamResult& result,
          << "\n";
   }
   if (!result.noise_learned.empty()) {
-    const std::map<std::string, double> factors = {
-        {"range", result.noise.range},
-        {"bearing", result.noise.bearing},
-        {"odometry", result.noise.odometry}};
     *out << "  noise        sigmas learned as the stated ones times:";
     const char* separator = " ";
     for (const std::string& kind : result.noise_learned) {
-      *out << separator << kind << " " << factors.at(kind);
+      *out << separator << kind << " "
+           << NoiseScale(result.noise, DataRowGroup(kind, 0));
       separator = ", ";
     }
     *out << "\n";
