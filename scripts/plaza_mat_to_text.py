@@ -49,18 +49,25 @@ def numeric_matrix(data):
 
 
 def load(path):
-    buf = open(path, 'rb').read()
+    try:
+        buf = open(path, 'rb').read()
+    except OSError as e:
+        sys.exit(f'{path}: cannot read: {e.strerror}')
     if not buf.startswith(b'MATLAB 5.0 MAT-file'):
         sys.exit(f'{path}: not a MATLAB 5 MAT-file')
     variables = {}
-    for kind, data in elements(buf, 128, len(buf)):
-        if kind == MI_COMPRESSED:
-            data = zlib.decompress(data)
-            kind, data = next(elements(data, 0, len(data)))
-        if kind == MI_MATRIX:
-            matrix = numeric_matrix(data)
-            if matrix is not None:
-                variables[matrix[0]] = matrix[1]
+    try:
+        for kind, data in elements(buf, 128, len(buf)):
+            if kind == MI_COMPRESSED:
+                data = zlib.decompress(data)
+                kind, data = next(elements(data, 0, len(data)))
+            if kind == MI_MATRIX:
+                matrix = numeric_matrix(data)
+                if matrix is not None:
+                    variables[matrix[0]] = matrix[1]
+    except (zlib.error, struct.error, ValueError, KeyError, IndexError,
+            StopIteration) as e:
+        sys.exit(f'{path}: truncated or corrupt MAT-file ({e})')
     return variables
 
 
@@ -74,7 +81,11 @@ def main():
     missing = [k for k in ('GT', 'DR', 'TD', 'TL') if k not in variables]
     if missing:
         sys.exit(f'{path}: no {", ".join(missing)} matrix')
-    os.makedirs(out_dir, exist_ok=True)
+    try:
+        os.makedirs(out_dir, exist_ok=True)
+    except OSError as e:
+        sys.exit(f'{out_dir}: cannot create the output directory: '
+                 f'{e.strerror}')
     for key in ('GT', 'DR', 'TD', 'TL'):
         out = os.path.join(out_dir, f'{name}_{key}.txt')
         np.savetxt(out, variables[key], fmt='%.10g')

@@ -67,3 +67,33 @@ def test_names_the_matrices_it_lacks(tmp_path):
                           capture_output=True, text=True, check=False)
     assert done.returncode == 1
     assert "no GT, TD, TL matrix" in done.stderr
+
+
+def test_names_a_truncated_file(tmp_path):
+    write_mat(tmp_path / "Plaza9_.mat", {"DR": np.ones((200, 3))})
+    data = (tmp_path / "Plaza9_.mat").read_bytes()
+    (tmp_path / "Plaza9_.mat").write_bytes(data[:len(data) - 40])
+    done = subprocess.run([sys.executable, str(SCRIPT),
+                           str(tmp_path / "Plaza9_.mat"), str(tmp_path / "out")],
+                          capture_output=True, text=True, check=False)
+    assert done.returncode == 1
+    assert "truncated or corrupt MAT-file" in done.stderr
+    assert "Traceback" not in done.stderr
+    assert not (tmp_path / "out").exists()
+
+
+def test_names_a_missing_input_and_an_output_that_is_a_file(tmp_path):
+    done = subprocess.run([sys.executable, str(SCRIPT),
+                           str(tmp_path / "none.mat"), str(tmp_path / "out")],
+                          capture_output=True, text=True, check=False)
+    assert done.returncode == 1
+    assert "none.mat: cannot read" in done.stderr
+    write_mat(tmp_path / "Plaza9_.mat", {k: np.ones((2, 3))
+                                         for k in ("DR", "GT", "TD", "TL")})
+    (tmp_path / "taken").write_text("x")
+    done = subprocess.run([sys.executable, str(SCRIPT),
+                           str(tmp_path / "Plaza9_.mat"), str(tmp_path / "taken")],
+                          capture_output=True, text=True, check=False)
+    assert done.returncode == 1
+    assert "cannot create the output directory" in done.stderr
+    assert (tmp_path / "taken").read_text() == "x"
