@@ -10,6 +10,7 @@
 #include "glog/logging.h"
 #include "rff_ceres/batch_solver.h"
 #include "rff_ceres/initialization.h"
+#include "rff_ceres/priors/trajectory_prior.h"
 #include "rff_ceres/quality_report.h"
 #include "rff_ceres/variance_components.h"
 
@@ -80,11 +81,9 @@ bool LearnScales(const Dataset& dataset,
                  std::map<LandmarkId, Eigen::Vector2d>* landmarks,
                  std::unique_ptr<SlamProblem>* problem, SlamResult* result,
                  std::string* error) {
-  const bool wnoa = settled->prior == "wnoa";
-  double* position_scale = wnoa ? &settled->wnoa.position_qc
-                                : &settled->trajectory.position_kernel.variance;
-  double* heading_scale = wnoa ? &settled->wnoa.heading_qc
-                               : &settled->trajectory.heading_kernel.variance;
+  const TrajectoryPrior& prior = PriorOf(*settled);
+  double* position_scale = prior.PositionScale(settled);
+  double* heading_scale = prior.HeadingScale(settled);
   NoiseScales& sigmas = settled->problem.noise;
   // Per noise group: its last fall (-log factor) and the rounds in a row
   // it fell by at least the round before's.
@@ -156,13 +155,13 @@ bool LearnScales(const Dataset& dataset,
       result->learning_converged = true;
       break;
     }
-    // Q_c scales the WNOA prior only: its states stay as they are. RFF
-    // features follow the variance (capacity): refit them to the estimate.
+    // A diffusion scales the prior only: the states stay as they are.
+    // Features follow the variance (capacity): refit them to the estimate.
     const std::vector<double> blocks = ModelBlocks(**model);
     const std::vector<TimedPose> estimate = result->trajectory;
     *model = CreateTrajectoryModel(dataset, *settled, mean, error);
     if (!*model) return false;
-    if (wnoa) {
+    if (!prior.has_features()) {
       SetModelBlocks(blocks, model->get());
     } else if (!FitModelToPoses(estimate, model->get(), error)) {
       return false;

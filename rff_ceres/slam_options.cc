@@ -6,14 +6,12 @@
 #include <string>
 #include <vector>
 
-#include "rff_ceres/feature_trajectory.h"
 #include "rff_ceres/io/text_parser.h"
 #include "rff_ceres/mean/localization_mean.h"
-#include "rff_ceres/mean/mean_function.h"
 #include "rff_ceres/mean/prior_mean.h"
 #include "rff_ceres/option_error.h"
+#include "rff_ceres/priors/trajectory_prior.h"
 #include "rff_ceres/slam_solver.h"
-#include "rff_ceres/wnoa_trajectory.h"
 
 namespace rff {
 namespace {
@@ -32,7 +30,7 @@ bool CheckOneOf(const std::string& value, const char* flag, const char* what,
 bool ValidateSlamOptions(const SlamOptions& options, std::string* error) {
   ceres::Solver::Options ceres_options;
   if (!ToCeresOptions(options.solver, &ceres_options, error) ||
-      !CheckOneOf(options.prior, "prior", "unknown prior", {"rff", "wnoa"},
+      !CheckOneOf(options.prior, "prior", "unknown prior", PriorNames(),
                   error) ||
       !CheckOneOf(options.prior_mean, "prior_mean", "unknown prior mean",
                   PriorMeanNames(), error) ||
@@ -42,9 +40,14 @@ bool ValidateSlamOptions(const SlamOptions& options, std::string* error) {
                   {"auto", "mean"}, error)) {
     return false;
   }
-  if (options.prior_mean == "wnoa" && options.prior != "rff") {
+  if (options.prior_mean == "wnoa" && !PriorOf(options).has_features()) {
+    std::vector<std::string> with_features;
+    for (const std::string& name : PriorNames()) {
+      if (FindPrior(name)->has_features()) with_features.push_back(name);
+    }
     *error = OptionError("prior_mean", "wnoa",
-                         "a WNOA-solve mean is for --prior=rff only");
+                         "a WNOA-solve mean is for --prior=" +
+                             JoinAlternatives(with_features) + " only");
     return false;
   }
   if (!CheckNonNegativeOption(options.solver.max_memory_gb, "max_memory_gb",
@@ -87,14 +90,8 @@ bool ValidateSlamOptions(const SlamOptions& options, std::string* error) {
   }
   // Every mean and pilot uses these, in the user's terms.
   if (!CheckLocalizationOptions(options.localization, error)) return false;
-  // Both priors' options, whichever is chosen (the RFF prior may start from
-  // a WNOA solve): each model is built once on a unit window, so that the
-  // checks are those of the real construction.
-  const auto mean = std::make_shared<PiecewiseLinearMean>(
-      std::vector<TimedPose>{{0.0, 0.0, 0.0, 0.0}});
-  if (!FeatureTrajectory::Create(options.trajectory, mean, 0.0, 1.0, error) ||
-      !WnoaTrajectory::Create(options.wnoa, mean, {0.0}, error)) {
-    return false;
+  for (const std::string& name : PriorNames()) {
+    if (!FindPrior(name)->CheckOptions(options, error)) return false;
   }
   if (!CheckCalibrationOptions(options.problem, error)) return false;
   std::unique_ptr<ceres::LossFunction> loss;

@@ -13,6 +13,7 @@
 #include "rff_ceres/io/pose_covariance_io.h"
 #include "rff_ceres/io/text_parser.h"
 #include "rff_ceres/io/tum_io.h"
+#include "rff_ceres/priors/trajectory_prior.h"
 
 namespace rff {
 namespace {
@@ -42,41 +43,10 @@ std::string JsonStringArray(const std::vector<std::string>& items) {
 void PrintSlamSummary(const SlamOptions& options, const SlamResult& result,
                       std::ostream* out) {
   const ceres::Solver::Summary& s = result.summary;
-  const FeatureTrajectoryOptions& t = result.trajectory_options;
-  if (options.prior == "wnoa") {
-    *out << "  model        WNOA (LTV-SDE) prior, Q_c = "
-         << result.wnoa_options.position_qc << " (x, y), "
-         << result.wnoa_options.heading_qc << " (theta), " << result.prior_mean
-         << " mean\n";
-  } else {
-    *out << "  model        " << t.family << " features, "
-         << t.position_kernel.name << " kernel, D = " << t.num_position_features
-         << " (x, y), " << t.num_heading_features << " (theta), "
-         << result.prior_mean << " mean";
-    if (result.prior_mean == "wnoa") {
-      *out << " (a WNOA solve, " << result.mean_seconds << " s)";
-    }
-    *out << "\n";
-    *out << "  kernels      lengthscale " << t.position_kernel.lengthscale
-         << " s, variance " << t.position_kernel.variance
-         << " (x, y); lengthscale " << t.heading_kernel.lengthscale
-         << " s, variance " << t.heading_kernel.variance << " (theta)";
-    if (t.segment_length > 0.0) {
-      *out << "; segments of " << t.segment_length << " s blended over "
-           << t.segment_overlap << " s";
-    }
-    *out << "\n";
-    if (result.learning.evaluations > 0) {
-      *out << "  learned      by the evidence (data linearised in poses) on "
-              "the first "
-           << result.learning.window_end - result.trajectory.front().t
-           << " s: log evidence " << result.learning.log_evidence << ", "
-           << result.learning.evaluations << " evaluations, "
-           << result.learning.seconds << " s\n";
-    }
-  }
+  const TrajectoryPrior& prior = PriorOf(options);
+  prior.PrintModel(result, out);
   if (result.learning_rounds > 0) {
-    *out << "  scales       " << (options.prior == "wnoa" ? "Q_c" : "variances")
+    *out << "  scales       " << prior.scales_name()
          << " learned by variance components, " << result.learning_rounds
          << " rounds"
          << (result.learning_converged

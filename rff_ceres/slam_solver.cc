@@ -17,26 +17,11 @@
 #include "rff_ceres/mean_rotation.h"
 #include "rff_ceres/option_error.h"
 #include "rff_ceres/posterior_covariance.h"
+#include "rff_ceres/priors/trajectory_prior.h"
 #include "rff_ceres/scale_learning.h"
 #include "rff_ceres/solve_start.h"
 
 namespace rff {
-namespace {
-
-// Every time the dataset mentions: the WNOA states reach both ends.
-void TimeSpan(const Dataset& dataset, double* begin, double* end) {
-  std::vector<double> times = OutputTimes(dataset);
-  for (const Odometry& o : dataset.odometry) {
-    times.push_back(o.t0);
-    times.push_back(o.t1);
-  }
-  for (const PosePrior& p : dataset.pose_priors) times.push_back(p.pose.t);
-  const auto [lo, hi] = std::minmax_element(times.begin(), times.end());
-  *begin = *lo;
-  *end = *hi;
-}
-
-}  // namespace
 
 std::vector<double> OutputTimes(const Dataset& dataset) {
   std::vector<double> times;
@@ -52,47 +37,6 @@ std::vector<double> OutputTimes(const Dataset& dataset) {
   std::sort(times.begin(), times.end());
   times.erase(std::unique(times.begin(), times.end()), times.end());
   return times;
-}
-
-std::unique_ptr<TrajectoryModel> CreateTrajectoryModel(
-    const Dataset& dataset, const SlamOptions& options,
-    std::shared_ptr<const MeanFunction> mean, std::string* error) {
-  const std::string mean_name = SettlePriorMean(options, dataset);
-  std::unique_ptr<TrajectoryModel> model;
-  if (options.prior == "rff") {
-    model = FeatureTrajectory::Create(options.trajectory, mean,
-                                      DataTimesOf(dataset), error);
-  } else if (options.prior == "wnoa") {
-    // A state at every distinct observation time, and at both ends of the
-    // run so that no query extrapolates. A constant mean leaves the motion
-    // to the states: one at each end of every odometry residual too, or the
-    // cubic between states could not follow it (a 64 s stretch without
-    // observations would be one cubic).
-    double t_begin, t_end;
-    TimeSpan(dataset, &t_begin, &t_end);
-    std::vector<double> times = {t_begin, t_end};
-    for (const Observation& o : dataset.observations) times.push_back(o.t);
-    std::vector<PreintegratedOdometry> chains;
-    if (mean_name == "constant" &&
-        !OdometryChains(dataset, options.problem, &chains, error)) {
-      return nullptr;
-    }
-    for (const PreintegratedOdometry& chain : chains) {
-      times.push_back(chain.t0);
-      times.push_back(chain.t1);
-    }
-    model = WnoaTrajectory::Create(options.wnoa, mean, std::move(times), error);
-  } else {
-    *error =
-        OptionError("prior", options.prior, "unknown prior", "rff or wnoa");
-    return nullptr;
-  }
-  if (!model || mean_name != "odometry") return model;
-  // Dead reckoning carries the error of its start heading: let it turn.
-  const PosePrior& start = EarliestPosePrior(dataset);
-  return std::make_unique<MeanRotationTrajectory>(
-      std::move(model), std::move(mean), start.pose.t,
-      std::min(start.sigma_theta, kLooseHeadingSigma));
 }
 
 namespace {
@@ -154,7 +98,8 @@ std::string SettlePriorMean(const SlamOptions& options,
   if (dataset.odometry.empty()) return "constant";
   const bool batch = options.incremental.every == 0;
   if (!batch) return "odometry";
-  return options.prior == "rff" ? "wnoa" : "constant";
+  const TrajectoryPrior* prior = FindPrior(options.prior);
+  return prior != nullptr && prior->has_features() ? "wnoa" : "constant";
 }
 
 namespace {
@@ -309,12 +254,13 @@ bool RunSlamAtOrigin(const Dataset& dataset, const SlamOptions& options,
   // WNOA learns its Q_c and the data's noise scales (LearnScales): its
   // prior is the only motion model besides the odometry, whose sigmas, like
   // the sensors', are the recording's guess.
+  const TrajectoryPrior& prior = PriorOf(options);
   const bool wnoa_learns =
-      options.prior == "wnoa" && options.learn_hyperparameters != "off";
+      !prior.has_features() && options.learn_hyperparameters != "off";
   // With a "wnoa" mean the RFF weights are a correction to a solve of the
   // same data: its variances start at what the capacity rule resolves and
   // are learned from the data (LearnScales).
-  const bool correction = options.prior == "rff" &&
+  const bool correction = prior.has_features() &&
                           result->prior_mean == "wnoa" &&
                           options.learn_hyperparameters != "off";
   if (correction) {
@@ -324,14 +270,14 @@ bool RunSlamAtOrigin(const Dataset& dataset, const SlamOptions& options,
     model = CreateTrajectoryModel(dataset, settled, mean, error);
     if (!model) return false;
   }
-  if (options.prior == "rff" && options.learn_hyperparameters == "auto" &&
+  if (prior.has_features() && options.learn_hyperparameters == "auto" &&
       !search && result->initial_trajectory == "localization") {
     // Drift of dead reckoning: its size from the pilot, its time scale given.
     MatchVariancesToSpread(*mean, initial, &settled.trajectory);
     model = CreateTrajectoryModel(dataset, settled, mean, error);
     if (!model || !FitModelToPoses(initial, model.get(), error)) return false;
   }
-  if (options.prior == "rff" && incremental.every == 0 && search) {
+  if (prior.has_features() && incremental.every == 0 && search) {
     // Linearised about (and the learned model started from) the WNOA solve
     // where there is one: the fit of the features to it is only as good as
     // their starting hyperparameters.

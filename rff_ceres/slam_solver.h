@@ -45,8 +45,8 @@ inline constexpr std::size_t kMaxCovarianceLandmarks = 10000;
 inline constexpr int kMaxOuterRounds = 100;
 
 struct SlamOptions {
-  // Trajectory prior: "rff" (weight-space features, FeatureTrajectory) or
-  // "wnoa" (LTV-SDE states, WnoaTrajectory).
+  // Trajectory prior, by its registry name (priors/trajectory_prior.h):
+  // "rff" (weight-space features) or "wnoa" (LTV-SDE states).
   std::string prior = "rff";
   // Prior mean (prior_mean.h). "auto" settles per dataset (SettlePriorMean):
   // for the RFF prior in batch mode with odometry, "wnoa".
@@ -165,12 +165,6 @@ bool ValidateSlamOptions(const SlamOptions& options, std::string* error);
 // when the solve fails or its result is not finite (divergence).
 bool RunSlam(const Dataset& dataset, const SlamOptions& options,
              SlamResult* result, std::string* error);
-
-// The trajectory model the options ask for, around `mean`, covering every
-// time of `dataset`.
-std::unique_ptr<TrajectoryModel> CreateTrajectoryModel(
-    const Dataset& dataset, const SlamOptions& options,
-    std::shared_ptr<const MeanFunction> mean, std::string* error);
 
 // Times at which RunSlam reports the trajectory: every distinct observation
 // and GT_POSE time, or, when there are none, the odometry and prior times.

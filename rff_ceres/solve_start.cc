@@ -10,6 +10,7 @@
 #include "rff_ceres/dead_reckoning.h"
 #include "rff_ceres/initialization.h"
 #include "rff_ceres/mean/prior_mean.h"
+#include "rff_ceres/priors/wnoa_prior.h"
 
 namespace rff {
 namespace {
@@ -19,7 +20,7 @@ namespace {
 bool SolveWnoa(const Dataset& dataset, const SlamOptions& options,
                bool covariance, SlamResult* solve, std::string* error) {
   SlamOptions wnoa = options;
-  wnoa.prior = "wnoa";
+  wnoa.prior = WnoaPrior::kName;
   wnoa.prior_mean = "auto";
   wnoa.outer_rounds = 0;
   wnoa.compute_covariance = covariance;
@@ -74,7 +75,7 @@ std::shared_ptr<const MeanFunction> BuildMean(
     SlamOptions* warm, SlamOptions* settled, SlamResult* wnoa_mean_solve,
     SlamResult* result, std::string* error) {
   std::shared_ptr<const MeanFunction> mean;
-  if (options.prior == "rff" && options.incremental.every == 0 &&
+  if (PriorOf(options).has_features() && options.incremental.every == 0 &&
       (result->prior_mean == "wnoa" ||
        (dataset.odometry.empty() && options.initial_trajectory == "auto" &&
         options.initial_poses.empty()))) {

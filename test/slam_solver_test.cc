@@ -11,6 +11,7 @@
 #include "rff_ceres/linear_system_size.h"
 #include "rff_ceres/mean/prior_mean.h"
 #include "rff_ceres/metrics.h"
+#include "rff_ceres/priors/trajectory_prior.h"
 #include "rff_ceres/simulate.h"
 #include "test/synthetic_options.h"
 

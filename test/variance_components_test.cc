@@ -16,6 +16,7 @@
 #include "rff_ceres/landmark_init.h"
 #include "rff_ceres/mean/prior_mean.h"
 #include "rff_ceres/metrics.h"
+#include "rff_ceres/priors/trajectory_prior.h"
 #include "rff_ceres/simulate.h"
 #include "rff_ceres/slam_report.h"
 #include "rff_ceres/slam_solver.h"

@@ -7,6 +7,7 @@
 #include "rff_ceres/convert/mrclam.h"
 #include "rff_ceres/io/dataset_io.h"
 #include "rff_ceres/io/text_parser.h"
+#include "rff_ceres/priors/trajectory_prior.h"
 #include "rff_ceres/simulate.h"
 
 namespace rff {
@@ -197,7 +198,8 @@ std::vector<OptionsVariant> SolverVariants(bool quick) {
           // Priors without features run once, with the sparse Cholesky:
           // eliminating landmarks seen from the whole run first leaves the
           // WNOA states in one dense system (Plaza: 21000 unknowns, hours).
-          if (options->prior != "rff" &&
+          const TrajectoryPrior* prior = FindPrior(options->prior);
+          if ((prior == nullptr || !prior->has_features()) &&
               (!first_features || solver != "SPARSE_NORMAL_CHOLESKY")) {
             return false;
           }

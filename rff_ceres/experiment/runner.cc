@@ -8,6 +8,7 @@
 
 #include "rff_ceres/dead_reckoning.h"
 #include "rff_ceres/metrics.h"
+#include "rff_ceres/priors/trajectory_prior.h"
 
 namespace rff {
 namespace {
@@ -43,11 +44,13 @@ void SolveAndEvaluate(const Dataset& dataset, const SlamOptions& base,
     return;
   }
   row->linear_solver = options.solver.linear_solver;
-  if (options.prior == "rff") {
+  const TrajectoryPrior* prior = FindPrior(options.prior);
+  const bool has_features = prior != nullptr && prior->has_features();
+  if (has_features) {
     row->features = options.trajectory.family;
     row->num_features = options.trajectory.num_position_features;
   } else {
-    // A prior without features (wnoa): its states are the model.
+    // A prior without features: its states are the model.
     row->features = options.prior;
     if (variant != nullptr)
       row->variant = row->linear_solver + " " + row->features;
@@ -60,7 +63,7 @@ void SolveAndEvaluate(const Dataset& dataset, const SlamOptions& base,
   }
   // What "auto" settled on, not what was asked for.
   row->linear_solver = result.linear_solver;
-  if (options.prior == "rff") {
+  if (has_features) {
     row->num_features = result.trajectory_options.num_position_features;
   }
   row->iterations = result.total_iterations;

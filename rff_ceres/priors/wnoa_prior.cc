@@ -1,0 +1,75 @@
+#include "rff_ceres/priors/wnoa_prior.h"
+
+#include <algorithm>
+#include <utility>
+#include <vector>
+
+#include "rff_ceres/slam_problem.h"
+#include "rff_ceres/wnoa_trajectory.h"
+
+namespace rff {
+namespace {
+
+// Every time the dataset mentions: the states reach both ends.
+void TimeSpan(const Dataset& dataset, double* begin, double* end) {
+  std::vector<double> times = OutputTimes(dataset);
+  for (const Odometry& o : dataset.odometry) {
+    times.push_back(o.t0);
+    times.push_back(o.t1);
+  }
+  for (const PosePrior& p : dataset.pose_priors) times.push_back(p.pose.t);
+  const auto [lo, hi] = std::minmax_element(times.begin(), times.end());
+  *begin = *lo;
+  *end = *hi;
+}
+
+}  // namespace
+
+bool WnoaPrior::CheckOptions(const SlamOptions& options,
+                             std::string* error) const {
+  return WnoaTrajectory::Create(options.wnoa, UnitWindowMean(), {0.0}, error) !=
+         nullptr;
+}
+
+std::unique_ptr<TrajectoryModel> WnoaPrior::CreateModel(
+    const Dataset& dataset, const SlamOptions& options,
+    const std::string& mean_name, std::shared_ptr<const MeanFunction> mean,
+    std::string* error) const {
+  // A state at every distinct observation time, and at both ends of the run
+  // so that no query extrapolates. A constant mean leaves the motion to the
+  // states: one at each end of every odometry residual too, or the cubic
+  // between states could not follow it (a 64 s stretch without observations
+  // would be one cubic).
+  double t_begin, t_end;
+  TimeSpan(dataset, &t_begin, &t_end);
+  std::vector<double> times = {t_begin, t_end};
+  for (const Observation& o : dataset.observations) times.push_back(o.t);
+  std::vector<PreintegratedOdometry> chains;
+  if (mean_name == "constant" &&
+      !OdometryChains(dataset, options.problem, &chains, error)) {
+    return nullptr;
+  }
+  for (const PreintegratedOdometry& chain : chains) {
+    times.push_back(chain.t0);
+    times.push_back(chain.t1);
+  }
+  return WnoaTrajectory::Create(options.wnoa, std::move(mean), std::move(times),
+                                error);
+}
+
+double* WnoaPrior::PositionScale(SlamOptions* options) const {
+  return &options->wnoa.position_qc;
+}
+
+double* WnoaPrior::HeadingScale(SlamOptions* options) const {
+  return &options->wnoa.heading_qc;
+}
+
+void WnoaPrior::PrintModel(const SlamResult& result, std::ostream* out) const {
+  *out << "  model        WNOA (LTV-SDE) prior, Q_c = "
+       << result.wnoa_options.position_qc << " (x, y), "
+       << result.wnoa_options.heading_qc << " (theta), " << result.prior_mean
+       << " mean\n";
+}
+
+}  // namespace rff
