@@ -21,6 +21,7 @@
 #include "rff_ceres/io/dataset_io.h"
 #include "rff_ceres/io/output_file.h"
 #include "rff_ceres/io/text_parser.h"
+#include "rff_ceres/measurement_types.h"
 #include "rff_ceres/option_error.h"
 #include "tool_flags.h"
 
@@ -98,17 +99,7 @@ int Fail(const std::string& message) {
 void PrintRecordCounts(const rff::Dataset& d) {
   std::map<std::string, std::size_t> observations;
   for (const rff::Observation& o : d.observations) {
-    switch (o.type) {
-      case rff::ObservationType::kRange:
-        ++observations["RANGE"];
-        break;
-      case rff::ObservationType::kBearing:
-        ++observations["BEARING"];
-        break;
-      case rff::ObservationType::kRangeBearing:
-        ++observations["RANGE_BEARING"];
-        break;
-    }
+    ++observations[rff::MeasurementTypeOf(o.type).record];
   }
   std::printf("records: PRIOR_POSE %zu, PRIOR_LANDMARK %zu, ODOM %zu",
               d.pose_priors.size(), d.landmark_priors.size(),

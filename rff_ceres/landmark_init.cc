@@ -105,7 +105,7 @@ bool InitializeLandmarks(const Dataset& dataset, const PoseFunction& pose,
     if (landmarks->count(o.id)) continue;
     Seen& s = seen[o.id];
     const Eigen::Vector3d p = pose(o.t);
-    if (o.type == ObservationType::kRangeBearing) {
+    if (o.HasRange() && o.HasBearing()) {
       s.rb_poses.push_back(p);
       s.rb_ranges.push_back(o.range);
       s.rb_bearings.push_back(o.bearing);

@@ -10,6 +10,7 @@
 #include "glog/logging.h"
 #include "rff_ceres/batch_solver.h"
 #include "rff_ceres/initialization.h"
+#include "rff_ceres/measurement_types.h"
 #include "rff_ceres/priors/trajectory_prior.h"
 #include "rff_ceres/quality_report.h"
 #include "rff_ceres/variance_components.h"
@@ -53,8 +54,8 @@ ceres::Solver::Options JudgingOptions(const ProblemOptions& options,
 bool SettleAutoLosses(SlamProblem* problem, ProblemOptions* options) {
   const std::map<std::string, std::vector<double>> residuals =
       problem->WhitenedResidualsByKind();
-  auto clean = [&](std::initializer_list<const char*> kinds) {
-    for (const char* kind : kinds) {
+  auto clean = [&](const std::vector<std::string>& kinds) {
+    for (const std::string& kind : kinds) {
       const auto it = residuals.find(kind);
       if (it == residuals.end()) continue;
       const double level = OutlierLevel(static_cast<int>(it->second.size()));
@@ -68,7 +69,11 @@ bool SettleAutoLosses(SlamProblem* problem, ProblemOptions* options) {
   auto settle = [&](bool is_clean, LossOptions* loss) {
     if (loss->name == "auto") loss->name = is_clean ? "none" : "cauchy";
   };
-  settle(clean({"range", "bearing", "range-bearing"}), &options->loss);
+  std::vector<std::string> observation_kinds;
+  for (const MeasurementType& type : MeasurementTypes()) {
+    observation_kinds.push_back(type.kind);
+  }
+  settle(clean(observation_kinds), &options->loss);
   settle(clean({"odometry"}), &options->odometry_loss);
   return judged;
 }

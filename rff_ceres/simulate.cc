@@ -50,34 +50,6 @@ double SimulationRandom::Normal() {
   return radius * std::cos(angle);
 }
 
-std::string MeasurementKindName(MeasurementKind kind) {
-  switch (kind) {
-    case MeasurementKind::kRange:
-      return "range";
-    case MeasurementKind::kBearing:
-      return "bearing";
-    case MeasurementKind::kRangeBearing:
-      return "range_bearing";
-  }
-  return "unknown";
-}
-
-bool ParseMeasurementKind(const std::string& name, MeasurementKind* kind,
-                          std::string* error) {
-  if (name == "range") {
-    *kind = MeasurementKind::kRange;
-  } else if (name == "bearing") {
-    *kind = MeasurementKind::kBearing;
-  } else if (name == "range_bearing" || name == "rb") {
-    *kind = MeasurementKind::kRangeBearing;
-  } else {
-    *error = OptionError("kind", name, "unknown measurement kind",
-                         "range, bearing or range_bearing");
-    return false;
-  }
-  return true;
-}
-
 std::string TrajectoryShapeName(TrajectoryShape model) {
   switch (model) {
     case TrajectoryShape::kWandering:
@@ -105,7 +77,7 @@ SimulationOptions KittiScaleOptions(std::uint64_t seed) {
   options.dt = 0.1;
   options.speed = 10.0;
   options.num_landmarks = 4000;
-  options.kind = MeasurementKind::kBearing;
+  options.kind = ObservationType::kBearing;
   options.sigma_bearing = 1.0 * M_PI / 180.0;
   options.observations_per_step = 15;
   options.sensor_range = 40.0;
@@ -125,7 +97,7 @@ SimulationOptions Laser10HzOptions(std::uint64_t seed) {
   options.speed = 1.0;
   // A 2D scanner (270 degrees, 1 to 20 m) whose feature extractor reports
   // the nearest features: posts, trees, corners.
-  options.kind = MeasurementKind::kRangeBearing;
+  options.kind = ObservationType::kRangeBearing;
   options.sigma_range = 0.05;
   options.sigma_bearing = 0.5 * M_PI / 180.0;
   options.sensor_range = 20.0;
@@ -693,17 +665,7 @@ bool Simulate(const SimulationOptions& options, Dataset* dataset,
       Observation observation;
       observation.t = pose.t;
       observation.id = landmark.id;
-      switch (options.kind) {
-        case MeasurementKind::kRange:
-          observation.type = ObservationType::kRange;
-          break;
-        case MeasurementKind::kBearing:
-          observation.type = ObservationType::kBearing;
-          break;
-        case MeasurementKind::kRangeBearing:
-          observation.type = ObservationType::kRangeBearing;
-          break;
-      }
+      observation.type = options.kind;
       if (observation.HasRange()) {
         // Plain Gaussian noise: near a landmark the measured range may be
         // negative, as in the shared benchmark sets (the format allows it).

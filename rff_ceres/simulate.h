@@ -13,20 +13,10 @@
 #include <random>
 #include <string>
 
+#include "rff_ceres/measurement_types.h"  // ParseMeasurementKind.
 #include "rff_ceres/types.h"
 
 namespace rff {
-
-// Which landmark measurement the simulated sensor returns.
-enum class MeasurementKind { kRange, kBearing, kRangeBearing };
-
-// "range", "bearing", "range_bearing".
-std::string MeasurementKindName(MeasurementKind kind);
-
-// Parses the names above (and the short form "rb" that the benchmark file
-// names use). Returns false and fills `error` for anything else.
-bool ParseMeasurementKind(const std::string& name, MeasurementKind* kind,
-                          std::string* error);
 
 // How the true trajectory is generated.
 enum class TrajectoryShape {
@@ -80,7 +70,7 @@ struct SimulationOptions {
   double landmark_prior_sigma = 5.0;
 
   // Measurements.
-  MeasurementKind kind = MeasurementKind::kRangeBearing;
+  ObservationType kind = ObservationType::kRangeBearing;
   double sigma_range = 1.0;                   // m
   double sigma_bearing = 2.0 * M_PI / 180.0;  // rad
   // Landmarks observed per pose: distinct, drawn at random among all

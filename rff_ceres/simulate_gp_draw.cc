@@ -30,7 +30,7 @@ SimulationOptions GpDrawOptions(std::uint64_t seed) {
   // 5 m around it puts every landmark within a few metres of some pose.
   options.landmark_margin = 5.0;
   options.landmark_prior_sigma = 1.0;
-  options.kind = MeasurementKind::kRangeBearing;
+  options.kind = ObservationType::kRangeBearing;
   options.sigma_range = 0.1;
   options.sigma_bearing = 2.0 * M_PI / 180.0;
   options.observations_per_step = 4;

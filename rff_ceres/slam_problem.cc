@@ -5,27 +5,22 @@
 #include <string_view>
 
 #include "Eigen/Eigenvalues"
-#include "costs/bearing_cost.h"
 #include "costs/calibrated_odometry_cost.h"
-#include "costs/calibrated_range_cost.h"
 #include "costs/diagonal_prior_cost.h"
 #include "costs/landmark_prior_cost.h"
-#include "costs/near_landmark_cost.h"
 #include "costs/odometry_cost.h"
 #include "costs/pose_prior_cost.h"
-#include "costs/range_bearing_cost.h"
-#include "costs/range_cost.h"
 #include "rff_ceres/io/text_parser.h"
+#include "rff_ceres/measurement_types.h"
 #include "rff_ceres/option_error.h"
 
 namespace rff {
 
 VarianceGroup DataRowGroup(std::string_view kind, int row) {
-  if (kind == "range" || (kind == "range-bearing" && row == 0)) {
-    return VarianceGroup::kRange;
-  }
-  if (kind == "bearing" || kind == "range-bearing") {
-    return VarianceGroup::kBearing;
+  if (const MeasurementType* type = FindMeasurementKind(kind)) {
+    // Rows are the measured values in the record's order: range first.
+    return type->range && row == 0 ? VarianceGroup::kRange
+                                   : VarianceGroup::kBearing;
   }
   return kind == "odometry" ? VarianceGroup::kOdometry : VarianceGroup::kFixed;
 }
@@ -93,40 +88,16 @@ void SlamProblem::AddObservation(const Observation& o) {
   PoseMap map = model_->PoseAt(o.t);
   double* landmark = landmark_block(o.id);
   std::vector<double*> blocks = LocalBlocks({&map}, landmark);
-  const double sigma_range = options_.noise.range * o.sigma_range;
-  const double sigma_bearing = options_.noise.bearing * o.sigma_bearing;
-  ceres::CostFunction* cost = nullptr;
-  switch (o.type) {
-    case ObservationType::kRange:
-      if (options_.range_calibration.estimate) {
-        blocks.push_back(range_calibration_.data());
-        cost = new CalibratedRangeCost(std::move(map), o.range, sigma_range);
-      } else {
-        cost = new RangeCost(std::move(map), o.range, sigma_range);
-      }
-      break;
-    case ObservationType::kBearing:
-      cost = new BearingCost(std::move(map), o.bearing, sigma_bearing);
-      break;
-    case ObservationType::kRangeBearing:
-      // Nearness is judged at the stated sigma: the form of a record stays
-      // fixed while its noise scales are learned.
-      if (o.range < kNearRangeSigmas * o.sigma_range) {
-        cost = new NearLandmarkCost(std::move(map), o.range, o.bearing,
-                                    sigma_range, sigma_bearing, o.sigma_range);
-      } else if (options_.range_calibration.estimate) {
-        blocks.push_back(range_calibration_.data());
-        cost = new CalibratedRangeBearingCost(
-            std::move(map), o.range, o.bearing, sigma_range, sigma_bearing);
-      } else {
-        cost = new RangeBearingCost(std::move(map), o.range, o.bearing,
-                                    sigma_range, sigma_bearing);
-      }
-      break;
+  ObservationResidualInputs inputs;
+  inputs.sigma_range = options_.noise.range * o.sigma_range;
+  inputs.sigma_bearing = options_.noise.bearing * o.sigma_bearing;
+  if (options_.range_calibration.estimate) {
+    inputs.range_calibration = range_calibration_.data();
   }
-  const char* kinds[] = {"range", "bearing", "range-bearing"};
+  const MeasurementType& type = MeasurementTypeOf(o.type);
+  ceres::CostFunction* cost = type.cost(o, std::move(map), inputs, &blocks);
   Remember(problem_->AddResidualBlock(cost, loss_.get(), blocks),
-           {kinds[static_cast<int>(o.type)], o.t, o.t, o.id, true});
+           {type.kind, o.t, o.t, o.id, true});
 }
 
 bool CheckCalibrationOptions(const ProblemOptions& options,

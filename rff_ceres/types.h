@@ -63,8 +63,9 @@ struct Observation {
   double sigma_range = 0.0;
   double sigma_bearing = 0.0;
 
-  bool HasRange() const { return type != ObservationType::kBearing; }
-  bool HasBearing() const { return type != ObservationType::kRange; }
+  // What the type measures (its entry in measurement_types.cc).
+  bool HasRange() const;
+  bool HasBearing() const;
 };
 
 // GT_LANDMARK id x y, and the rows of a .landmarks file (with an optional

@@ -147,7 +147,7 @@ TEST(QualityReportTest, RangeCalibrationOfMirroredRunStaysPhysical) {
   SimulationOptions sim = PaperOptions(13);
   sim.num_steps = 120;
   sim.num_landmarks = 20;
-  sim.kind = MeasurementKind::kRange;
+  sim.kind = ObservationType::kRange;
   Dataset dataset;
   std::string error;
   ASSERT_TRUE(Simulate(sim, &dataset, &error)) << error;

@@ -219,9 +219,9 @@ TEST(SimulateTest, PaperProtocolShape) {
 }
 
 TEST(SimulateTest, NoiseFreeMeasurementsAreTheExactGeometry) {
-  for (MeasurementKind kind :
-       {MeasurementKind::kRange, MeasurementKind::kBearing,
-        MeasurementKind::kRangeBearing}) {
+  for (ObservationType kind :
+       {ObservationType::kRange, ObservationType::kBearing,
+        ObservationType::kRangeBearing}) {
     SimulationOptions options = PaperOptions(11);
     options.kind = kind;
     options.noise_free = true;
@@ -243,8 +243,8 @@ TEST(SimulateTest, NoiseFreeMeasurementsAreTheExactGeometry) {
         EXPECT_GT(o.bearing, -M_PI);
         EXPECT_LE(o.bearing, M_PI);
       }
-      EXPECT_EQ(o.HasRange(), kind != MeasurementKind::kBearing);
-      EXPECT_EQ(o.HasBearing(), kind != MeasurementKind::kRange);
+      EXPECT_EQ(o.HasRange(), kind != ObservationType::kBearing);
+      EXPECT_EQ(o.HasBearing(), kind != ObservationType::kRange);
     }
     ASSERT_EQ(d.odometry.size(), 299u);
     for (const Odometry& o : d.odometry) {
@@ -329,7 +329,7 @@ TEST(SimulateTest, SwitchingOneOptionLeavesTheOtherDrawsAlone) {
   options.noise_free = true;
   ASSERT_TRUE(Simulate(options, &noise_free, &error));
   options.noise_free = false;
-  options.kind = MeasurementKind::kBearing;
+  options.kind = ObservationType::kBearing;
   ASSERT_TRUE(Simulate(options, &bearing_only, &error));
 
   EXPECT_TRUE(without_odometry.odometry.empty());
@@ -349,9 +349,9 @@ TEST(SimulateTest, SwitchingOneOptionLeavesTheOtherDrawsAlone) {
 }
 
 TEST(SimulateTest, EveryVariantParsesBack) {
-  for (MeasurementKind kind :
-       {MeasurementKind::kRange, MeasurementKind::kBearing,
-        MeasurementKind::kRangeBearing}) {
+  for (ObservationType kind :
+       {ObservationType::kRange, ObservationType::kBearing,
+        ObservationType::kRangeBearing}) {
     for (bool odometry : {false, true}) {
       for (int landmarks : {1, 5, 100}) {
         SimulationOptions options = PaperOptions(landmarks);
@@ -576,21 +576,6 @@ TEST(SimulateTest, RejectsBadOptionsWithAMessage) {
   std::string error;
   EXPECT_TRUE(ValidateSimulationOptions(PaperOptions(1), &error)) << error;
   EXPECT_TRUE(ValidateSimulationOptions(KittiScaleOptions(1), &error)) << error;
-}
-
-TEST(SimulateTest, MeasurementKindNames) {
-  MeasurementKind kind;
-  std::string error;
-  ASSERT_TRUE(ParseMeasurementKind("range", &kind, &error));
-  EXPECT_EQ(kind, MeasurementKind::kRange);
-  ASSERT_TRUE(ParseMeasurementKind("rb", &kind, &error));
-  EXPECT_EQ(kind, MeasurementKind::kRangeBearing);
-  ASSERT_TRUE(ParseMeasurementKind("bearing", &kind, &error));
-  EXPECT_EQ(MeasurementKindName(kind), "bearing");
-  EXPECT_FALSE(ParseMeasurementKind("lidar", &kind, &error));
-  EXPECT_EQ(error,
-            "--kind=lidar: unknown measurement kind; allowed range, bearing or "
-            "range_bearing");
 }
 
 }  // namespace

@@ -541,7 +541,7 @@ TEST(SlamSolverTest, IncrementalModeTracksTheBatchSolution) {
 // A sensor that reads 6% long with a 0.4 m offset, on simulated `kind`
 // records: the calibration recovers it and the APE falls below
 // `max_ape_ratio` times the uncalibrated solve's.
-void ExpectRangeCalibrationRecovered(MeasurementKind kind,
+void ExpectRangeCalibrationRecovered(ObservationType kind,
                                      double max_ape_ratio) {
   SimulationOptions sim = PaperOptions(19);
   sim.kind = kind;
@@ -563,11 +563,11 @@ void ExpectRangeCalibrationRecovered(MeasurementKind kind,
 }
 
 TEST(SlamSolverTest, RangeCalibrationIsRecovered) {
-  ExpectRangeCalibrationRecovered(MeasurementKind::kRange, 0.7);
+  ExpectRangeCalibrationRecovered(ObservationType::kRange, 0.7);
 }
 
 TEST(SlamSolverTest, RangeCalibrationCoversRangeBearingRecords) {
-  ExpectRangeCalibrationRecovered(MeasurementKind::kRangeBearing, 1.0);
+  ExpectRangeCalibrationRecovered(ObservationType::kRangeBearing, 1.0);
 }
 
 // Odometry that reads 8% long and turns 7% short (as commanded velocities
@@ -818,7 +818,7 @@ TEST(SlamSolverTest, NothingToEstimateIsAnError) {
 TEST(SlamProblemTest, LandmarkSeenByOneRangeIsNotDetermined) {
   SimulationOptions sim = PaperOptions(18);
   sim.num_steps = 30;
-  sim.kind = MeasurementKind::kRange;
+  sim.kind = ObservationType::kRange;
   Dataset dataset;
   std::string error;
   ASSERT_TRUE(Simulate(sim, &dataset, &error)) << error;

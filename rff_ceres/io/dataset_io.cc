@@ -8,16 +8,23 @@
 
 #include "rff_ceres/io/output_file.h"
 #include "rff_ceres/io/text_parser.h"
+#include "rff_ceres/measurement_types.h"
 
 namespace rff {
 namespace {
 
-// Numbers of fields after the record name, per record type.
+// Numbers of fields after the record name, per record type: an observation
+// has t, id, and a value and a sigma per measured quantity.
 const std::map<std::string_view, std::size_t>& RecordArity() {
-  static const auto* const arity = new std::map<std::string_view, std::size_t>{
-      {"RFFD", 1},          {"PRIOR_POSE", 6}, {"PRIOR_LANDMARK", 4},
-      {"ODOM", 8},          {"RANGE", 4},      {"BEARING", 4},
-      {"RANGE_BEARING", 6}, {"GT_POSE", 4},    {"GT_LANDMARK", 3}};
+  static const auto* const arity = [] {
+    auto* counts = new std::map<std::string_view, std::size_t>{
+        {"RFFD", 1}, {"PRIOR_POSE", 6}, {"PRIOR_LANDMARK", 4},
+        {"ODOM", 8}, {"GT_POSE", 4},    {"GT_LANDMARK", 3}};
+    for (const MeasurementType& m : MeasurementTypes()) {
+      (*counts)[m.record] = 2 + 2 * (int{m.range} + int{m.bearing});
+    }
+    return counts;
+  }();
   return *arity;
 }
 
@@ -55,7 +62,7 @@ class DatasetParser {
       return name == "PRIOR_LANDMARK" ? AddLandmarkPrior(id, v)
                                       : AddGroundTruthLandmark(id, v);
     }
-    if (name == "RANGE" || name == "BEARING" || name == "RANGE_BEARING") {
+    if (const MeasurementType* type = FindMeasurementRecord(name)) {
       double t;
       LandmarkId id;
       double v[4];
@@ -63,7 +70,7 @@ class DatasetParser {
           !Numbers(fields, 3, fields.size() - 3, v)) {
         return false;
       }
-      return AddObservation(name, t, id, v);
+      return AddObservation(*type, t, id, v);
     }
     double v[8];
     if (!Numbers(fields, 1, fields.size() - 1, v)) return false;
@@ -156,25 +163,23 @@ class DatasetParser {
     return true;
   }
 
-  bool AddObservation(std::string_view name, double t, LandmarkId id,
+  // `v`: the measured values, then their sigmas (MeasurementType::record).
+  bool AddObservation(const MeasurementType& type, double t, LandmarkId id,
                       const double* v) {
     Observation obs;
+    obs.type = type.type;
     obs.t = t;
     obs.id = id;
-    if (name == "RANGE") {
-      obs.type = ObservationType::kRange;
-      obs.range = v[0];
-      obs.sigma_range = v[1];
-    } else if (name == "BEARING") {
-      obs.type = ObservationType::kBearing;
-      obs.bearing = WrapAngle(v[0]);
-      obs.sigma_bearing = v[1];
-    } else {
-      obs.type = ObservationType::kRangeBearing;
-      obs.range = v[0];
-      obs.bearing = WrapAngle(v[1]);
-      obs.sigma_range = v[2];
-      obs.sigma_bearing = v[3];
+    const int measured = int{type.range} + int{type.bearing};
+    int field = 0;
+    if (type.range) {
+      obs.range = v[field];
+      obs.sigma_range = v[field + measured];
+      ++field;
+    }
+    if (type.bearing) {
+      obs.bearing = WrapAngle(v[field]);
+      obs.sigma_bearing = v[field + measured];
     }
     // A noisy range may be negative (a Gaussian measurement of a short
     // distance): it is data, not an error.
@@ -306,21 +311,13 @@ void WriteDataset(const Dataset& dataset, std::ostream* output) {
         << n(o.sigma_y) << " " << n(o.sigma_theta) << "\n";
   }
   for (const Observation& o : dataset.observations) {
-    switch (o.type) {
-      case ObservationType::kRange:
-        out << "RANGE " << n(o.t) << " " << o.id << " " << n(o.range) << " "
-            << n(o.sigma_range) << "\n";
-        break;
-      case ObservationType::kBearing:
-        out << "BEARING " << n(o.t) << " " << o.id << " " << n(o.bearing) << " "
-            << n(o.sigma_bearing) << "\n";
-        break;
-      case ObservationType::kRangeBearing:
-        out << "RANGE_BEARING " << n(o.t) << " " << o.id << " " << n(o.range)
-            << " " << n(o.bearing) << " " << n(o.sigma_range) << " "
-            << n(o.sigma_bearing) << "\n";
-        break;
-    }
+    const MeasurementType& type = MeasurementTypeOf(o.type);
+    out << type.record << " " << n(o.t) << " " << o.id;
+    if (type.range) out << " " << n(o.range);
+    if (type.bearing) out << " " << n(o.bearing);
+    if (type.range) out << " " << n(o.sigma_range);
+    if (type.bearing) out << " " << n(o.sigma_bearing);
+    out << "\n";
   }
   for (const TimedPose& p : dataset.ground_truth) {
     out << "GT_POSE " << n(p.t) << " " << n(p.x) << " " << n(p.y) << " "

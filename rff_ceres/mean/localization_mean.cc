@@ -299,7 +299,7 @@ std::vector<Eigen::Vector3d> Seeds(
     Eigen::Vector2d sum = Eigen::Vector2d::Zero();
     int count = 0;
     for (const Observation& o : observations) {
-      if (o.type != ObservationType::kRangeBearing || !landmarks.count(o.id)) {
+      if (!o.HasRange() || !o.HasBearing() || !landmarks.count(o.id)) {
         continue;
       }
       const double angle = seed.z() + o.bearing;

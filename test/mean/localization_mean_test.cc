@@ -15,7 +15,7 @@ using ::testing::HasSubstr;
 
 // The paper's protocol, shortened, without noise: the landmark priors are
 // the true positions and every measurement is exact.
-Dataset NoiseFree(MeasurementKind kind, bool odometry) {
+Dataset NoiseFree(ObservationType kind, bool odometry) {
   SimulationOptions sim = PaperOptions(7);
   sim.num_steps = 80;
   sim.num_landmarks = 12;
@@ -40,7 +40,7 @@ const TimedPose& TruthAt(const Dataset& dataset, double t) {
   return dataset.ground_truth.front();
 }
 
-void ExpectExactFixesAndCloseMean(MeasurementKind kind, bool odometry,
+void ExpectExactFixesAndCloseMean(ObservationType kind, bool odometry,
                                   double mean_tolerance,
                                   double heading_tolerance) {
   const Dataset dataset = NoiseFree(kind, odometry);
@@ -54,7 +54,7 @@ void ExpectExactFixesAndCloseMean(MeasurementKind kind, bool odometry,
   EXPECT_EQ(report.rejected, 0);
   EXPECT_EQ(report.fused_odometry, odometry);
   EXPECT_EQ(report.heading_from_velocity,
-            kind == MeasurementKind::kRange && !odometry);
+            kind == ObservationType::kRange && !odometry);
   for (const PoseFix& fix : report.fixes) {
     const TimedPose& truth = TruthAt(dataset, fix.pose.t);
     EXPECT_NEAR(fix.pose.x, truth.x, 1e-6) << fix.pose.t;
@@ -74,22 +74,22 @@ void ExpectExactFixesAndCloseMean(MeasurementKind kind, bool odometry,
 }
 
 TEST(LocalizationMeanTest, RangeBearingNoiseFreeIsRecovered) {
-  ExpectExactFixesAndCloseMean(MeasurementKind::kRangeBearing, false, 0.02,
+  ExpectExactFixesAndCloseMean(ObservationType::kRangeBearing, false, 0.02,
                                0.01);
 }
 
 TEST(LocalizationMeanTest, BearingOnlyNoiseFreeIsRecovered) {
-  ExpectExactFixesAndCloseMean(MeasurementKind::kBearing, false, 0.02, 0.01);
+  ExpectExactFixesAndCloseMean(ObservationType::kBearing, false, 0.02, 0.01);
 }
 
 TEST(LocalizationMeanTest, RangeOnlyTakesTheHeadingFromTheMotion) {
   // Position fixes are exact; the heading is the direction of the smoothed
   // velocity, which the unicycle's heading equals.
-  ExpectExactFixesAndCloseMean(MeasurementKind::kRange, false, 0.02, 0.05);
+  ExpectExactFixesAndCloseMean(ObservationType::kRange, false, 0.02, 0.05);
 }
 
 TEST(LocalizationMeanTest, FusesOdometryAsADriftCorrection) {
-  ExpectExactFixesAndCloseMean(MeasurementKind::kRangeBearing, true, 1e-3,
+  ExpectExactFixesAndCloseMean(ObservationType::kRangeBearing, true, 1e-3,
                                1e-3);
 }
 
@@ -124,7 +124,7 @@ TEST(LocalizationMeanTest, NoLocalisableTimeIsAClearError) {
   // Range-only with one landmark in view per step: never enough ranges.
   SimulationOptions sim = PaperOptions(3);
   sim.num_steps = 10;
-  sim.kind = MeasurementKind::kRange;
+  sim.kind = ObservationType::kRange;
   sim.odometry = false;
   sim.observations_per_step = 1;
   Dataset dataset;
@@ -149,7 +149,7 @@ TEST(LocalizationMeanTest, NoLocalisableTimeIsAClearError) {
 }
 
 TEST(PriorMeanTest, RegistryRejectsUnknownNames) {
-  const Dataset dataset = NoiseFree(MeasurementKind::kRangeBearing, false);
+  const Dataset dataset = NoiseFree(ObservationType::kRangeBearing, false);
   std::string error;
   EXPECT_EQ(BuildPriorMean("magic", dataset, &error), nullptr);
   EXPECT_EQ(error,
@@ -162,7 +162,7 @@ TEST(PriorMeanTest, RegistryRejectsUnknownNames) {
 }
 
 TEST(PriorMeanTest, LocalizationAndSplineFollowTheFixesAndAutoStaysOffData) {
-  const Dataset dataset = NoiseFree(MeasurementKind::kRangeBearing, false);
+  const Dataset dataset = NoiseFree(ObservationType::kRangeBearing, false);
   const TimedPose& last = dataset.ground_truth.back();
   for (const char* name : {"localization", "spline"}) {
     std::string error;
@@ -189,7 +189,7 @@ TEST(PriorMeanTest, LocalizationAndSplineFollowTheFixesAndAutoStaysOffData) {
 // the localisation at the observation times, p = 0 is the straight line
 // through it (De Boor's csaps), far from the run's end.
 TEST(PriorMeanTest, SplineSmoothingReachesTheSplineMean) {
-  const Dataset dataset = NoiseFree(MeasurementKind::kRangeBearing, false);
+  const Dataset dataset = NoiseFree(ObservationType::kRangeBearing, false);
   std::string error;
   const auto localization = BuildPriorMean("localization", dataset, &error);
   const auto interpolating =
@@ -213,7 +213,7 @@ TEST(PriorMeanTest, SplineSmoothingReachesTheSplineMean) {
 TEST(PriorMeanTest, LocalizationOptionsReachTheMean) {
   // With odometry fusion switched off, the mean is the smoothed fixes alone
   // (not exact between them); with it, dead reckoning makes it exact.
-  const Dataset dataset = NoiseFree(MeasurementKind::kRangeBearing, true);
+  const Dataset dataset = NoiseFree(ObservationType::kRangeBearing, true);
   LocalizationOptions fixes_only;
   fixes_only.use_odometry = false;
   std::string error;
@@ -240,7 +240,7 @@ TEST(PriorMeanTest, LocalizationOptionsReachTheMean) {
 }
 
 TEST(PriorMeanTest, BadLocalizationOptionsAreNamedForEveryMean) {
-  const Dataset dataset = NoiseFree(MeasurementKind::kRangeBearing, true);
+  const Dataset dataset = NoiseFree(ObservationType::kRangeBearing, true);
   LocalizationOptions options;
   options.correction_smoothing = 0.0;
   std::string error;
