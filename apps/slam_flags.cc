@@ -21,19 +21,23 @@ DEFINE_string(initial_trajectory, "auto",
               "prior mean) or mean.");
 DEFINE_double(localization_position_smoothing, 0.2,
               "Localization mean: acceleration noise density of the position "
-              "smoother (m^2/s^3); larger follows the fixes more closely.");
+              "smoother (m^2/s^3), more than 0; larger follows the fixes more "
+              "closely.");
 DEFINE_double(localization_heading_smoothing, 0.005,
-              "Localization mean: the same for the heading (rad^2/s^3).");
+              "Localization mean: the same for the heading (rad^2/s^3), more "
+              "than 0.");
 DEFINE_double(localization_correction_smoothing, 1e-4,
               "Localization mean with odometry: density of the smoother of "
-              "the correction to dead reckoning.");
+              "the correction to dead reckoning, more than 0.");
 DEFINE_bool(localization_use_odometry, true,
             "Localization mean: fuse the ODOM records (dead reckoning "
             "corrected towards the fixes) when the dataset has them.");
 DEFINE_string(kernel, "rbf",
               "Kernel of x and y: rbf, matern12, matern32, matern52, "
               "periodic.");
-DEFINE_string(heading_kernel, "", "Kernel of theta (default: --kernel).");
+DEFINE_string(heading_kernel, "",
+              "Kernel of theta: empty (--kernel), rbf, matern12, matern32, "
+              "matern52, periodic.");
 DEFINE_double(lengthscale, 10.0,
               "Kernel lengthscale of x and y (seconds), more than 0 up to "
               "1e12 (periodic: at least 0.001).");
@@ -71,34 +75,38 @@ DEFINE_string(learn_hyperparameters, "auto",
               "WNOA mean. Batch mode only. auto is off when a kernel "
               "hyperparameter or Q_c is given (command line or flagfile): "
               "they are then the user's choice.");
-DEFINE_uint64(seed, 1, "Seed of the random feature frequencies.");
+DEFINE_uint64(seed, 1,
+              "Seed of the random feature frequencies, 0 to 2^64 - 1.");
 DEFINE_double(segment_length, 0.0,
               "Windowed weights: segment length in seconds (0: one global "
-              "feature map over each stretch of data). At most 100000 "
-              "segments.");
+              "feature map over each stretch of data), 0 or more; at most "
+              "100000 segments.");
 DEFINE_double(segment_overlap, 0.0,
-              "Windowed weights: blend overlap between segments (seconds), "
-              "less than --segment_length.");
+              "Windowed weights: blend overlap between segments (seconds), 0 "
+              "or more, less than --segment_length.");
 
 // WNOA (LTV-SDE) prior.
 DEFINE_double(wnoa_position_qc, 1.0,
               "WNOA: power spectral density Q_c of the x and y acceleration "
-              "(m^2/s^3).");
-DEFINE_double(wnoa_heading_qc, 0.1,
-              "WNOA: Q_c of the heading acceleration (rad^2/s^3).");
-DEFINE_double(wnoa_initial_position_sigma, 10.0,
-              "WNOA: prior sigma of the first state's position deviation (m).");
+              "(m^2/s^3), more than 0.");
 DEFINE_double(
-    wnoa_initial_heading_sigma, 1.0,
-    "WNOA: prior sigma of the first state's heading deviation (rad).");
+    wnoa_heading_qc, 0.1,
+    "WNOA: Q_c of the heading acceleration (rad^2/s^3), more than 0.");
+DEFINE_double(wnoa_initial_position_sigma, 10.0,
+              "WNOA: prior sigma of the first state's position deviation (m), "
+              "more than 0.");
+DEFINE_double(wnoa_initial_heading_sigma, 1.0,
+              "WNOA: prior sigma of the first state's heading deviation (rad), "
+              "more than 0.");
 DEFINE_double(wnoa_initial_velocity_sigma, 1.0,
-              "WNOA: prior sigma of the first state's velocity (m/s).");
+              "WNOA: prior sigma of the first state's velocity (m/s), more "
+              "than 0.");
 DEFINE_double(wnoa_initial_angular_velocity_sigma, 1.0,
               "WNOA: prior sigma of the first state's angular velocity "
-              "(rad/s).");
+              "(rad/s), more than 0.");
 DEFINE_double(wnoa_min_state_spacing, 0.0,
-              "WNOA: merge states closer than this (seconds); 0 keeps one "
-              "per observation time.");
+              "WNOA: merge states closer than this (seconds), 0 or more; 0 "
+              "keeps one per observation time.");
 
 // Incremental mode.
 DEFINE_int32(incremental_every, 0,
@@ -107,7 +115,7 @@ DEFINE_int32(incremental_every, 0,
              "more.");
 DEFINE_double(incremental_lag, 0.0,
               "Incremental mode: freeze trajectory blocks untouched for this "
-              "many seconds (0: never freeze).");
+              "many seconds, 0 or more (0: never freeze).");
 
 DEFINE_int32(outer_rounds, 0,
              "Smoothing-spline prior rounds (paper III-B.2): refit the mean "
@@ -130,21 +138,22 @@ DEFINE_bool(estimate_range_calibration, false,
             "(one per run) for the ranges of RANGE and RANGE_BEARING records, "
             "for ranges with a systematic bias.");
 DEFINE_double(range_scale_sigma, 0.1,
-              "Prior sigma of the range scale around 1.");
+              "Prior sigma of the range scale around 1, more than 0.");
 DEFINE_double(range_offset_sigma, 1.0,
-              "Prior sigma of the range offset around 0 (m).");
+              "Prior sigma of the range offset around 0 (m), more than 0.");
 DEFINE_bool(estimate_odometry_calibration, false,
             "Estimate the odometry's translation scale and turn scale jointly "
             "(one each per run): the ODOM motion is modelled as the true one "
             "scaled, as commanded velocities and wheel radii have it.");
 DEFINE_double(odometry_scale_sigma, 0.1,
-              "Prior sigma of both odometry scales around 1.");
+              "Prior sigma of both odometry scales around 1, more than 0.");
 DEFINE_bool(use_odometry, true, "Add the ODOM records as residuals.");
 DEFINE_bool(preintegrate_odometry, true,
             "Compose ODOM chains between observation times into one residual "
             "each (first-order covariance).");
 DEFINE_double(max_preintegration_seconds, 1.0,
-              "Longest time one preintegrated odometry chain may span.");
+              "Longest time one preintegrated odometry chain may span "
+              "(seconds), 0 or more.");
 
 // Ceres.
 DEFINE_double(max_memory_gb, 0.0,
@@ -156,7 +165,8 @@ DEFINE_string(linear_solver, "auto",
               "Ceres linear solver: auto (DENSE_SCHUR when at most 2000 "
               "trajectory parameters remain after eliminating the landmarks, "
               "else SPARSE_NORMAL_CHOLESKY), DENSE_SCHUR, SPARSE_SCHUR, "
-              "ITERATIVE_SCHUR, DENSE_QR, SPARSE_NORMAL_CHOLESKY, CGNR, ...");
+              "ITERATIVE_SCHUR, DENSE_QR, DENSE_NORMAL_CHOLESKY, "
+              "SPARSE_NORMAL_CHOLESKY or CGNR.");
 DEFINE_string(preconditioner, "auto",
               "Ceres preconditioner of ITERATIVE_SCHUR and CGNR: IDENTITY, "
               "JACOBI, SCHUR_JACOBI, CLUSTER_JACOBI, CLUSTER_TRIDIAGONAL; "
@@ -170,9 +180,11 @@ DEFINE_int32(num_threads, 1,
              "1 or more.");
 DEFINE_int32(max_iterations, 100,
              "Maximum number of solver iterations (1 or more).");
-DEFINE_double(function_tolerance, 1e-8, "Ceres function tolerance.");
-DEFINE_double(gradient_tolerance, 1e-10, "Ceres gradient tolerance.");
-DEFINE_double(parameter_tolerance, 1e-8, "Ceres parameter tolerance.");
+DEFINE_double(function_tolerance, 1e-8, "Ceres function tolerance, 0 or more.");
+DEFINE_double(gradient_tolerance, 1e-10,
+              "Ceres gradient tolerance, 0 or more.");
+DEFINE_double(parameter_tolerance, 1e-8,
+              "Ceres parameter tolerance, 0 or more.");
 
 namespace rff {
 namespace {

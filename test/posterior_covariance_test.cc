@@ -425,7 +425,7 @@ void AddCoverage(std::uint64_t seed, SlamOptions options, Coverage* coverage) {
   }
 }
 
-// The calibration: on simulated data about 95% of true positions lie
+// Calibration: on simulated data about 95% of true positions lie
 // inside the 2-sigma (95%) ellipse of the posterior. Range-bearing with
 // odometry, the paper's protocol (300 poses, 50 landmarks per seed). Errors
 // within one run are strongly correlated (a drift of the whole map), so one

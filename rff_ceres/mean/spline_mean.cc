@@ -6,6 +6,7 @@
 #include "Eigen/SparseCholesky"
 #include "Eigen/SparseCore"
 #include "rff_ceres/io/text_parser.h"
+#include "rff_ceres/option_error.h"
 
 namespace rff {
 
@@ -23,8 +24,7 @@ bool CubicSmoothingSpline::Fit(const std::vector<double>& t,
     return false;
   }
   if (!(p >= 0.0 && p <= 1.0)) {
-    *error = "smoothing spline: smoothing p must be in [0, 1], got " +
-             FormatNumber(p);
+    *error = OptionError("spline_smoothing", FormatNumber(p), "", "0 to 1");
     return false;
   }
   for (std::size_t i = 0; i < n; ++i) {
