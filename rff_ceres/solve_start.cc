@@ -10,7 +10,7 @@
 #include "rff_ceres/dead_reckoning.h"
 #include "rff_ceres/initialization.h"
 #include "rff_ceres/mean/prior_mean.h"
-#include "rff_ceres/priors/wnoa_prior.h"
+#include "rff_ceres/priors/trajectory_prior.h"
 
 namespace rff {
 namespace {
@@ -20,7 +20,7 @@ namespace {
 bool SolveWnoa(const Dataset& dataset, const SlamOptions& options,
                bool covariance, SlamResult* solve, std::string* error) {
   SlamOptions wnoa = options;
-  wnoa.prior = WnoaPrior::kName;
+  wnoa.prior = WnoaPrior().name();
   wnoa.prior_mean = "auto";
   wnoa.outer_rounds = 0;
   wnoa.compute_covariance = covariance;

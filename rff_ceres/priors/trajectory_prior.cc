@@ -8,17 +8,15 @@
 #include "rff_ceres/io/text_parser.h"
 #include "rff_ceres/mean_rotation.h"
 #include "rff_ceres/option_error.h"
-#include "rff_ceres/priors/feature_prior.h"
-#include "rff_ceres/priors/wnoa_prior.h"
 
 namespace rff {
 namespace {
 
-// The registry: one line per prior (never destroyed, as statics should not be).
+// The registry: one line per prior.
 const std::vector<const TrajectoryPrior*>& Registry() {
   static const auto* registry = new std::vector<const TrajectoryPrior*>{
-      new FeaturePrior,
-      new WnoaPrior,
+      &FeaturePrior(),
+      &WnoaPrior(),
   };
   return *registry;
 }

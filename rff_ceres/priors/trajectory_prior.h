@@ -1,8 +1,9 @@
 // A trajectory prior as the solve sees it: how its model is built from the
 // options, which options hold the scales that variance components
-// re-estimate, and how the summary describes it. Adding a prior is one class
-// in a file of its own and one line in the registry (trajectory_prior.cc);
-// no other code names a prior.
+// re-estimate, and how the summary describes it. Adding a prior is one file
+// in priors/ (a class and the function that returns it), its declaration
+// below and one line in the registry (trajectory_prior.cc); no other code
+// names a prior.
 #ifndef RFF_CERES_PRIORS_TRAJECTORY_PRIOR_H_
 #define RFF_CERES_PRIORS_TRAJECTORY_PRIOR_H_
 
@@ -54,6 +55,11 @@ class TrajectoryPrior {
   virtual void PrintModel(const SlamResult& result,
                           std::ostream* out) const = 0;
 };
+
+// The registered priors, one file each: "rff" (feature_prior.cc) and "wnoa"
+// (wnoa_prior.cc).
+const TrajectoryPrior& FeaturePrior();
+const TrajectoryPrior& WnoaPrior();
 
 // The mean at the origin the priors' CheckOptions build on.
 std::shared_ptr<const MeanFunction> UnitWindowMean();

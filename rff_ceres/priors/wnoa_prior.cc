@@ -1,9 +1,11 @@
-#include "rff_ceres/priors/wnoa_prior.h"
-
+// "wnoa": the LTV-SDE prior of Barfoot et al. (white noise on acceleration),
+// a pose and velocity state at the data's times (WnoaTrajectory); its scales
+// are the diffusions Q_c of position and heading.
 #include <algorithm>
 #include <utility>
 #include <vector>
 
+#include "rff_ceres/priors/trajectory_prior.h"
 #include "rff_ceres/slam_problem.h"
 #include "rff_ceres/wnoa_trajectory.h"
 
@@ -23,53 +25,64 @@ void TimeSpan(const Dataset& dataset, double* begin, double* end) {
   *end = *hi;
 }
 
+class WnoaPriorImpl : public TrajectoryPrior {
+ public:
+  const char* name() const override { return "wnoa"; }
+  bool has_features() const override { return false; }
+
+  bool CheckOptions(const SlamOptions& options,
+                    std::string* error) const override {
+    return WnoaTrajectory::Create(options.wnoa, UnitWindowMean(), {0.0},
+                                  error) != nullptr;
+  }
+
+  std::unique_ptr<TrajectoryModel> CreateModel(
+      const Dataset& dataset, const SlamOptions& options,
+      const std::string& mean_name, std::shared_ptr<const MeanFunction> mean,
+      std::string* error) const override {
+    // A state at every distinct observation time, and at both ends of the run
+    // so that no query extrapolates. A constant mean leaves the motion to the
+    // states: one at each end of every odometry residual too, or the cubic
+    // between states could not follow it (a 64 s stretch without observations
+    // would be one cubic).
+    double t_begin, t_end;
+    TimeSpan(dataset, &t_begin, &t_end);
+    std::vector<double> times = {t_begin, t_end};
+    for (const Observation& o : dataset.observations) times.push_back(o.t);
+    std::vector<PreintegratedOdometry> chains;
+    if (mean_name == "constant" &&
+        !OdometryChains(dataset, options.problem, &chains, error)) {
+      return nullptr;
+    }
+    for (const PreintegratedOdometry& chain : chains) {
+      times.push_back(chain.t0);
+      times.push_back(chain.t1);
+    }
+    return WnoaTrajectory::Create(options.wnoa, std::move(mean),
+                                  std::move(times), error);
+  }
+
+  double* PositionScale(SlamOptions* options) const override {
+    return &options->wnoa.position_qc;
+  }
+  double* HeadingScale(SlamOptions* options) const override {
+    return &options->wnoa.heading_qc;
+  }
+  const char* scales_name() const override { return "Q_c"; }
+
+  void PrintModel(const SlamResult& result, std::ostream* out) const override {
+    *out << "  model        WNOA (LTV-SDE) prior, Q_c = "
+         << result.wnoa_options.position_qc << " (x, y), "
+         << result.wnoa_options.heading_qc << " (theta), " << result.prior_mean
+         << " mean\n";
+  }
+};
+
 }  // namespace
 
-bool WnoaPrior::CheckOptions(const SlamOptions& options,
-                             std::string* error) const {
-  return WnoaTrajectory::Create(options.wnoa, UnitWindowMean(), {0.0}, error) !=
-         nullptr;
-}
-
-std::unique_ptr<TrajectoryModel> WnoaPrior::CreateModel(
-    const Dataset& dataset, const SlamOptions& options,
-    const std::string& mean_name, std::shared_ptr<const MeanFunction> mean,
-    std::string* error) const {
-  // A state at every distinct observation time, and at both ends of the run
-  // so that no query extrapolates. A constant mean leaves the motion to the
-  // states: one at each end of every odometry residual too, or the cubic
-  // between states could not follow it (a 64 s stretch without observations
-  // would be one cubic).
-  double t_begin, t_end;
-  TimeSpan(dataset, &t_begin, &t_end);
-  std::vector<double> times = {t_begin, t_end};
-  for (const Observation& o : dataset.observations) times.push_back(o.t);
-  std::vector<PreintegratedOdometry> chains;
-  if (mean_name == "constant" &&
-      !OdometryChains(dataset, options.problem, &chains, error)) {
-    return nullptr;
-  }
-  for (const PreintegratedOdometry& chain : chains) {
-    times.push_back(chain.t0);
-    times.push_back(chain.t1);
-  }
-  return WnoaTrajectory::Create(options.wnoa, std::move(mean), std::move(times),
-                                error);
-}
-
-double* WnoaPrior::PositionScale(SlamOptions* options) const {
-  return &options->wnoa.position_qc;
-}
-
-double* WnoaPrior::HeadingScale(SlamOptions* options) const {
-  return &options->wnoa.heading_qc;
-}
-
-void WnoaPrior::PrintModel(const SlamResult& result, std::ostream* out) const {
-  *out << "  model        WNOA (LTV-SDE) prior, Q_c = "
-       << result.wnoa_options.position_qc << " (x, y), "
-       << result.wnoa_options.heading_qc << " (theta), " << result.prior_mean
-       << " mean\n";
+const TrajectoryPrior& WnoaPrior() {
+  static const auto* prior = new WnoaPriorImpl;
+  return *prior;
 }
 
 }  // namespace rff
