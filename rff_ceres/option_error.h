@@ -8,6 +8,7 @@
 #define RFF_CERES_OPTION_ERROR_H_
 
 #include <cmath>
+#include <initializer_list>
 #include <string>
 
 #include "rff_ceres/io/text_parser.h"  // FormatNumber, for the values.
@@ -41,6 +42,26 @@ inline bool CheckNonNegativeOption(double value, const char* flag,
                        std::isfinite(value) ? "" : "not a finite number",
                        "0 or more");
   return false;
+}
+
+// A numeric option and its flag: more than 0, or 0 or more when
+// `zero_allowed`.
+struct NumericOption {
+  double value;
+  const char* flag;
+  bool zero_allowed;
+};
+
+// Checks `options` in order; the first bad one fills `error`.
+inline bool CheckNumericOptions(std::initializer_list<NumericOption> options,
+                                std::string* error) {
+  for (const NumericOption& o : options) {
+    if (!(o.zero_allowed ? CheckNonNegativeOption(o.value, o.flag, error)
+                         : CheckPositiveOption(o.value, o.flag, error))) {
+      return false;
+    }
+  }
+  return true;
 }
 
 }  // namespace rff

@@ -469,10 +469,8 @@ bool WriteG2o(const Dataset& input, std::ostream* output,
 
 bool WriteG2o(const Dataset& dataset, const std::string& path,
               G2oWriteSummary* summary, std::string* error) {
-  std::ostringstream text;
-  if (!WriteG2o(dataset, &text, summary, error)) return false;
-  return WriteOutputFile(
-      path, [&](std::ostream* out) { *out << text.str(); }, error);
+  return WriteGraphFile<G2oWriteSummary>(&WriteG2o, dataset, path, summary,
+                                         error);
 }
 
 }  // namespace rff

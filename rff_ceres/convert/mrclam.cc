@@ -259,18 +259,13 @@ std::string ConverterDescription(const MrclamOptions& o) {
 }
 
 bool CheckOptions(const MrclamOptions& o, std::string* error) {
-  auto positive = [&](double v, const char* name) {
-    return CheckPositiveOption(v, name, error);
-  };
-  auto non_negative = [&](double v, const char* name) {
-    return CheckNonNegativeOption(v, name, error);
-  };
   if (o.robot < 1 || o.robot > kLastRobotSubject) {
     *error = OptionError("mrclam_robot", std::to_string(o.robot), "",
                          "1 to " + std::to_string(kLastRobotSubject));
     return false;
   }
-  if (!non_negative(o.odometry_interval, "mrclam_odometry_interval")) {
+  if (!CheckNonNegativeOption(o.odometry_interval, "mrclam_odometry_interval",
+                              error)) {
     return false;
   }
   if (o.odometry_interval > 0.0 && o.odometry_interval < 0.01) {
@@ -280,19 +275,19 @@ bool CheckOptions(const MrclamOptions& o, std::string* error) {
                          "more");
     return false;
   }
-  return positive(o.range_sigma, "mrclam_range_sigma") &&
-         positive(o.bearing_sigma, "mrclam_bearing_sigma") &&
-         positive(o.odometry_sigma_xy_floor, "mrclam_odom_sigma_xy_floor") &&
-         non_negative(o.odometry_sigma_xy_per_metre,
-                      "mrclam_odom_sigma_xy_per_m") &&
-         positive(o.odometry_sigma_theta_floor,
-                  "mrclam_odom_sigma_theta_floor") &&
-         non_negative(o.odometry_sigma_theta_per_second,
-                      "mrclam_odom_sigma_theta_per_s") &&
-         non_negative(o.landmark_prior_sigma, "mrclam_landmark_prior_sigma") &&
-         positive(o.first_pose_sigma_xy, "prior_sigma_xy") &&
-         positive(o.first_pose_sigma_theta, "prior_sigma_theta") &&
-         non_negative(o.gt_rate_hz, "gt_rate_hz");
+  return CheckNumericOptions(
+      {{o.range_sigma, "mrclam_range_sigma", false},
+       {o.bearing_sigma, "mrclam_bearing_sigma", false},
+       {o.odometry_sigma_xy_floor, "mrclam_odom_sigma_xy_floor", false},
+       {o.odometry_sigma_xy_per_metre, "mrclam_odom_sigma_xy_per_m", true},
+       {o.odometry_sigma_theta_floor, "mrclam_odom_sigma_theta_floor", false},
+       {o.odometry_sigma_theta_per_second, "mrclam_odom_sigma_theta_per_s",
+        true},
+       {o.landmark_prior_sigma, "mrclam_landmark_prior_sigma", true},
+       {o.first_pose_sigma_xy, "prior_sigma_xy", false},
+       {o.first_pose_sigma_theta, "prior_sigma_theta", false},
+       {o.gt_rate_hz, "gt_rate_hz", true}},
+      error);
 }
 
 }  // namespace

@@ -456,12 +456,6 @@ std::string ConverterDescription(const PlazaOptions& o) {
 }
 
 bool CheckOptions(const PlazaOptions& o, std::string* error) {
-  auto positive = [&](double v, const char* name) {
-    return CheckPositiveOption(v, name, error);
-  };
-  auto non_negative = [&](double v, const char* name) {
-    return CheckNonNegativeOption(v, name, error);
-  };
   if (o.name.empty()) {
     *error = OptionError("plaza_name", o.name, "empty",
                          "a file prefix such as Plaza1");
@@ -473,19 +467,19 @@ bool CheckOptions(const PlazaOptions& o, std::string* error) {
                     "auto or a finite number [rad]");
     return false;
   }
-  return positive(o.outlier_threshold, "plaza_outlier_threshold") &&
-         non_negative(o.range_sigma, "plaza_range_sigma") &&
-         positive(o.odometry_sigma_xy_floor, "plaza_odom_sigma_xy_floor") &&
-         non_negative(o.odometry_sigma_xy_per_metre,
-                      "plaza_odom_sigma_xy_per_m") &&
-         positive(o.odometry_sigma_theta_floor,
-                  "plaza_odom_sigma_theta_floor") &&
-         non_negative(o.odometry_sigma_theta_per_radian,
-                      "plaza_odom_sigma_theta_per_rad") &&
-         non_negative(o.landmark_prior_sigma, "plaza_landmark_prior_sigma") &&
-         positive(o.first_pose_sigma_xy, "prior_sigma_xy") &&
-         positive(o.first_pose_sigma_theta, "prior_sigma_theta") &&
-         positive(o.heading_offset_tolerance, "plaza_heading_offset_tolerance");
+  return CheckNumericOptions(
+      {{o.outlier_threshold, "plaza_outlier_threshold", false},
+       {o.range_sigma, "plaza_range_sigma", true},
+       {o.odometry_sigma_xy_floor, "plaza_odom_sigma_xy_floor", false},
+       {o.odometry_sigma_xy_per_metre, "plaza_odom_sigma_xy_per_m", true},
+       {o.odometry_sigma_theta_floor, "plaza_odom_sigma_theta_floor", false},
+       {o.odometry_sigma_theta_per_radian, "plaza_odom_sigma_theta_per_rad",
+        true},
+       {o.landmark_prior_sigma, "plaza_landmark_prior_sigma", true},
+       {o.first_pose_sigma_xy, "prior_sigma_xy", false},
+       {o.first_pose_sigma_theta, "prior_sigma_theta", false},
+       {o.heading_offset_tolerance, "plaza_heading_offset_tolerance", false}},
+      error);
 }
 
 }  // namespace

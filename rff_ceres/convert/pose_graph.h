@@ -7,9 +7,12 @@
 
 #include <Eigen/Core>
 #include <cstddef>
+#include <ostream>
+#include <sstream>
 #include <string>
 #include <vector>
 
+#include "rff_ceres/io/output_file.h"
 #include "rff_ceres/types.h"
 
 namespace rff {
@@ -65,6 +68,19 @@ std::vector<double> DiagonalUpperTriangle(const std::vector<double>& sigmas,
 // `values` separated by single blanks, each in the shortest form that reads
 // back exactly.
 std::string JoinNumbers(const std::vector<double>& values);
+
+// Writes the text a format's stream writer `write` makes of `dataset` to
+// `path`, whole or not at all (WriteOutputFile).
+template <typename Summary>
+bool WriteGraphFile(bool (*write)(const Dataset&, std::ostream*, Summary*,
+                                  std::string*),
+                    const Dataset& dataset, const std::string& path,
+                    Summary* summary, std::string* error) {
+  std::ostringstream text;
+  if (!write(dataset, &text, summary, error)) return false;
+  return WriteOutputFile(
+      path, [&](std::ostream* out) { *out << text.str(); }, error);
+}
 
 }  // namespace rff
 

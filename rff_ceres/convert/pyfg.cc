@@ -566,10 +566,8 @@ bool WritePyfg(const Dataset& dataset, std::ostream* output,
 
 bool WritePyfg(const Dataset& dataset, const std::string& path,
                PyfgWriteSummary* summary, std::string* error) {
-  std::ostringstream text;
-  if (!WritePyfg(dataset, &text, summary, error)) return false;
-  return WriteOutputFile(
-      path, [&](std::ostream* out) { *out << text.str(); }, error);
+  return WriteGraphFile<PyfgWriteSummary>(&WritePyfg, dataset, path, summary,
+                                          error);
 }
 
 }  // namespace rff
