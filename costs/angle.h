@@ -15,6 +15,15 @@ inline double WrapAngle(double angle) {
   return wrapped;
 }
 
+// The same for Ceres Jets: ceil has a zero derivative, so the wrap leaves
+// the gradient alone. Doubles take the exact remainder form above.
+template <typename T>
+T WrapAngle(const T& angle) {
+  using std::ceil;
+  const T two_pi = T(2.0 * M_PI);
+  return angle - two_pi * ceil((angle - T(M_PI)) / two_pi);
+}
+
 }  // namespace rff
 
 #endif  // RFF_COSTS_ANGLE_H_

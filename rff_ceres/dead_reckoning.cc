@@ -59,7 +59,7 @@ bool IntegrateOdometry(const TimedPose& start, std::vector<Odometry> odometry,
       }
     }
     times.push_back(record.t1);
-    motions.push_back({record.dx, record.dy, NormalizeAngle(record.dtheta)});
+    motions.push_back({record.dx, record.dy, WrapAngle(record.dtheta)});
     previous = &record;
   }
   if (!gaps->empty() && !options.hold_through_gaps) {
@@ -96,7 +96,7 @@ bool IntegrateOdometry(const TimedPose& start, std::vector<Odometry> odometry,
     const Pose2& d = motions[anchor];
     const double alpha =
         (t - times[anchor]) / (times[anchor + 1] - times[anchor]);
-    const double theta = NormalizeAngle(start_pose.theta - alpha * d.theta);
+    const double theta = WrapAngle(start_pose.theta - alpha * d.theta);
     const double c = std::cos(theta), s = std::sin(theta);
     poses[anchor] = {start_pose.x - alpha * (c * d.x - s * d.y),
                      start_pose.y - alpha * (s * d.x + c * d.y), theta};

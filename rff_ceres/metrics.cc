@@ -143,7 +143,7 @@ bool AlignPositions(const std::vector<Pose2>& source,
   const double angle = std::atan2(cross, dot);
   const double c = std::cos(angle), s = std::sin(angle);
   *transform = {tx - (c * sx - s * sy), ty - (s * sx + c * sy),
-                NormalizeAngle(angle)};
+                WrapAngle(angle)};
   return true;
 }
 

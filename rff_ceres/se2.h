@@ -21,17 +21,6 @@ struct Pose2T {
 };
 using Pose2 = Pose2T<double>;
 
-// Wraps an angle to (-pi, pi]. The generic form works for Ceres Jets (ceil
-// has a zero derivative, so the wrap does not disturb the gradient).
-template <typename T>
-T NormalizeAngle(const T& angle) {
-  using std::ceil;
-  const T two_pi = T(2.0 * M_PI);
-  return angle - two_pi * ceil((angle - T(M_PI)) / two_pi);
-}
-// For doubles use the exact remainder-based wrap of the readers.
-inline double NormalizeAngle(double angle) { return WrapAngle(angle); }
-
 // a * b: the pose b, given in the frame of a, expressed in a's parent frame.
 template <typename T>
 Pose2T<T> Compose(const Pose2T<T>& a, const Pose2T<T>& b) {
@@ -40,7 +29,7 @@ Pose2T<T> Compose(const Pose2T<T>& a, const Pose2T<T>& b) {
   const T c = cos(a.theta);
   const T s = sin(a.theta);
   return {a.x + c * b.x - s * b.y, a.y + s * b.x + c * b.y,
-          NormalizeAngle(a.theta + b.theta)};
+          WrapAngle(a.theta + b.theta)};
 }
 
 // a^-1, so that Compose(a, Inverse(a)) is the identity.
@@ -50,7 +39,7 @@ Pose2T<T> Inverse(const Pose2T<T>& a) {
   using std::sin;
   const T c = cos(a.theta);
   const T s = sin(a.theta);
-  return {-(c * a.x + s * a.y), s * a.x - c * a.y, NormalizeAngle(-a.theta)};
+  return {-(c * a.x + s * a.y), s * a.x - c * a.y, WrapAngle(-a.theta)};
 }
 
 // a^-1 * b: the pose b seen from the frame of a (the form of an ODOM record).
@@ -62,7 +51,7 @@ Pose2T<T> Between(const Pose2T<T>& a, const Pose2T<T>& b) {
   const T s = sin(a.theta);
   const T dx = b.x - a.x;
   const T dy = b.y - a.y;
-  return {c * dx + s * dy, -s * dx + c * dy, NormalizeAngle(b.theta - a.theta)};
+  return {c * dx + s * dy, -s * dx + c * dy, WrapAngle(b.theta - a.theta)};
 }
 
 // Pose at fraction `alpha` from a (0) to b (1): linear in x and y, heading
@@ -70,7 +59,7 @@ Pose2T<T> Between(const Pose2T<T>& a, const Pose2T<T>& b) {
 template <typename T>
 Pose2T<T> Interpolate(const Pose2T<T>& a, const Pose2T<T>& b, const T& alpha) {
   return {a.x + alpha * (b.x - a.x), a.y + alpha * (b.y - a.y),
-          NormalizeAngle(a.theta + alpha * NormalizeAngle(b.theta - a.theta))};
+          WrapAngle(a.theta + alpha * WrapAngle(b.theta - a.theta))};
 }
 
 inline Pose2 ToPose2(const TimedPose& p) { return {p.x, p.y, p.theta}; }

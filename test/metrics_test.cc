@@ -102,9 +102,9 @@ TEST(Se2Test, ComposeInverseBetweenAndGenericWrap) {
   EXPECT_NEAR(seen.y, -1.0, 1e-12);
   EXPECT_NEAR(seen.theta, -M_PI / 2, 1e-12);
   // The generic (Jet-capable) wrap agrees with WrapAngle: (-pi, pi].
-  EXPECT_NEAR(NormalizeAngle<double>(3.0 * M_PI), M_PI, 1e-12);
-  EXPECT_NEAR(NormalizeAngle<double>(-M_PI), M_PI, 1e-12);
-  EXPECT_NEAR(NormalizeAngle<double>(-3.5), 2.0 * M_PI - 3.5, 1e-12);
+  EXPECT_NEAR(WrapAngle<double>(3.0 * M_PI), M_PI, 1e-12);
+  EXPECT_NEAR(WrapAngle<double>(-M_PI), M_PI, 1e-12);
+  EXPECT_NEAR(WrapAngle<double>(-3.5), 2.0 * M_PI - 3.5, 1e-12);
   using Jet = ceres::Jet<double, 1>;
   const Pose2T<Jet> p{Jet(0.0), Jet(0.0), Jet(3.0, 0)};
   const Pose2T<Jet> q{Jet(1.0), Jet(0.0), Jet(0.5)};

@@ -59,6 +59,8 @@ std::pair<T, T> LandmarkOffset(const Eigen::Matrix<T, 3, 1>& pose,
   return {landmark[0] - pose[0], landmark[1] - pose[1]};
 }
 
+// The twins' wrap: a formula of its own (atan2 of sin and cos), not
+// WrapAngle, so that they do not share the code they check.
 template <typename T>
 T Wrap(const T& angle) {
   using std::atan2;
