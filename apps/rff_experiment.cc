@@ -178,6 +178,11 @@ int main(int argc, char** argv) {
     *options = rff::SlamOptionsFromFlags();
     options->solver.num_threads = num_threads;
     options->solver.log_progress = false;
+    // Checked here, before the row reads its dataset.
+    if (!rff::ValidateSlamOptions(*options, message)) {
+      *message = path + ": " + *message;
+      return false;
+    }
     return true;
   };
 

@@ -228,14 +228,13 @@ TEST(RunExperimentTest, FailedMethodsAndDatasetsAreRowsAndTheGridGoesOn) {
   };
   experiment.datasets.push_back(broken);
   const std::vector<Method> methods = {{"good", ""}, {"noconfig", ""}};
-  int callbacks = 0;
+  std::vector<std::string> asked;  // The families options were asked for.
   const OptionsCallback callback =
       [&](const std::string& method, const std::string& family,
           SlamOptions* options, std::string* error) {
-        ++callbacks;
-        EXPECT_EQ(family, "synthetic_range_bearing");
+        asked.push_back(family);
         if (method == "noconfig") {
-          *error = "cfg/synthetic_range_bearing_noconfig.flags: cannot read";
+          *error = "cfg/" + family + "_noconfig.flags: cannot read";
           return false;
         }
         *options = SmallOptions();
@@ -247,7 +246,11 @@ TEST(RunExperimentTest, FailedMethodsAndDatasetsAreRowsAndTheGridGoesOn) {
   const std::vector<RunRow> rows =
       RunExperiment(experiment, methods, callback, &progress);
   ASSERT_EQ(rows.size(), 6u);
-  EXPECT_EQ(callbacks, 4);  // Never asked for the broken dataset.
+  // Options are settled before each dataset is made, the broken one too.
+  EXPECT_EQ(asked, (std::vector<std::string>{
+                       "synthetic_range_bearing", "synthetic_range_bearing",
+                       "synthetic_range_bearing", "synthetic_range_bearing",
+                       "plaza", "plaza"}));
   for (int i : {0, 2}) {
     const RunRow& row = rows[i];
     EXPECT_EQ(row.method, "good");
@@ -273,7 +276,8 @@ TEST(RunExperimentTest, FailedMethodsAndDatasetsAreRowsAndTheGridGoesOn) {
   EXPECT_EQ(rows[4].dataset, "broken");
   EXPECT_EQ(rows[4].status,
             "failed: dataset broken: missing.rffd: cannot open");
-  EXPECT_EQ(rows[5].status, rows[4].status);
+  // A method without options fails on them, whatever the dataset.
+  EXPECT_EQ(rows[5].status, "failed: cfg/plaza_noconfig.flags: cannot read");
 
   const std::vector<std::string> lines = Lines(log.str());
   ASSERT_EQ(lines.size(), 6u);
@@ -282,8 +286,8 @@ TEST(RunExperimentTest, FailedMethodsAndDatasetsAreRowsAndTheGridGoesOn) {
   EXPECT_THAT(lines[1], StartsWith("[2/6] noconfig synthetic_range_bearing "
                                    "L=10 noise=x1 seed=1: failed: cfg/"));
   EXPECT_EQ(lines[5],
-            "[6/6] noconfig plaza broken: failed: dataset broken: "
-            "missing.rffd: cannot open");
+            "[6/6] noconfig plaza broken: failed: cfg/plaza_noconfig.flags: "
+            "cannot read");
 
   // The runs table: header, one line per row, the failure quoted (it has
   // no comma, so unquoted) and empty metric cells.
@@ -297,6 +301,29 @@ TEST(RunExperimentTest, FailedMethodsAndDatasetsAreRowsAndTheGridGoesOn) {
   const std::vector<std::string> failed = Cells(csv_lines[2]);
   EXPECT_EQ(failed[1], "noconfig");
   EXPECT_EQ(failed[14], "");  // ape_trans_m.
+}
+
+TEST(RunExperimentTest, NoDatasetIsMadeWhenNoMethodHasValidOptions) {
+  Experiment experiment;
+  experiment.name = "table1";
+  int made = 0;
+  DatasetSpec spec = SmallSpec("small_s1", 1);
+  spec.make = [&made](Dataset*, std::string*) {
+    ++made;
+    return true;
+  };
+  experiment.datasets = {spec};
+  const OptionsCallback bad_value = [](const std::string&, const std::string&,
+                                       SlamOptions*, std::string* error) {
+    *error = "cfg/x.flags: --lengthscale=-1: allowed more than 0";
+    return false;
+  };
+  const std::vector<RunRow> rows =
+      RunExperiment(experiment, {{"bad", ""}}, bad_value, nullptr);
+  ASSERT_EQ(rows.size(), 1u);
+  EXPECT_EQ(made, 0);
+  EXPECT_EQ(rows[0].status,
+            "failed: cfg/x.flags: --lengthscale=-1: allowed more than 0");
 }
 
 TEST(RunExperimentTest, VariantsOverrideOptionsAndKeepSolutions) {

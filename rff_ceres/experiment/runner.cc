@@ -148,9 +148,25 @@ std::vector<RunRow> RunExperiment(const Experiment& experiment,
                                   Progress* progress) {
   std::vector<RunRow> rows;
   for (const DatasetSpec& spec : experiment.datasets) {
+    // Each method's options once per dataset, checked before the dataset is
+    // made or read; a method without them is one failed row for all the
+    // variants.
+    std::vector<SlamOptions> method_options(methods.size());
+    std::vector<std::string> option_errors(methods.size());
+    bool any_options = false;
+    for (std::size_t m = 0; m < methods.size(); ++m) {
+      std::string& why = option_errors[m];
+      if (!options_callback(methods[m].name, spec.family, &method_options[m],
+                            &why)) {
+        if (why.empty()) why = "no options for method " + methods[m].name;
+      } else {
+        why.clear();
+        any_options = true;
+      }
+    }
     Dataset dataset;
     std::string dataset_error;
-    bool made = spec.make && spec.make(&dataset, &dataset_error);
+    bool made = any_options && spec.make && spec.make(&dataset, &dataset_error);
     if (!spec.make) dataset_error = "no way to make the dataset";
     if (made && dataset.ground_truth.empty()) {
       made = false;
@@ -161,7 +177,8 @@ std::vector<RunRow> RunExperiment(const Experiment& experiment,
 
     const std::size_t num_variants =
         std::max<std::size_t>(1, experiment.variants.size());
-    for (const Method& method : methods) {
+    for (std::size_t m = 0; m < methods.size(); ++m) {
+      const Method& method = methods[m];
       RunRow base_row;
       base_row.experiment = experiment.name;
       base_row.method = method.name;
@@ -174,16 +191,10 @@ std::vector<RunRow> RunExperiment(const Experiment& experiment,
       base_row.seed = spec.seed;
       base_row.dead_reckoning_ape_translation = dead_reckoning_ape;
 
-      // The method's options once per dataset; when there are none, one
-      // failed row stands for all the variants.
-      SlamOptions base;
-      std::string why;
-      if (!made) {
+      const SlamOptions& base = method_options[m];
+      std::string why = option_errors[m];
+      if (why.empty() && !made) {
         why = "dataset " + spec.name + ": " + dataset_error;
-      } else if (!options_callback(method.name, spec.family, &base, &why)) {
-        if (why.empty()) why = "no options for method " + method.name;
-      } else {
-        why.clear();
       }
       if (!why.empty()) {
         FailRow(why, &base_row);
