@@ -228,7 +228,7 @@ SlamOptions SlamOptionsFromFlags() {
     options.learn_hyperparameters = "off";
   }
   options.spline_smoothing = FLAGS_spline_smoothing;
-  FeatureTrajectoryOptions& t = options.trajectory;
+  FeatureTrajectoryOptions& t = options.features;
   t.position_kernel.name = FLAGS_kernel;
   t.position_kernel.lengthscale = FLAGS_lengthscale;
   t.position_kernel.variance = FLAGS_kernel_variance;

@@ -179,7 +179,7 @@ SlamOptions BenchOptions(int num_features, double segment,
                          const std::string& solver) {
   // Odometry mean: the dataset has ODOM.
   SlamOptions options = testing::SyntheticRangeBearingOptions();
-  FeatureTrajectoryOptions& t = options.trajectory;
+  FeatureTrajectoryOptions& t = options.features;
   t.num_position_features = num_features;
   t.num_heading_features = num_features;
   t.segment_length = segment;
@@ -294,7 +294,7 @@ ProblemSetup& CachedSetup(int n, int d, int l, int segment) {
     // odometry times cover the observations).
     const double t_begin = dataset.ground_truth.front().t;
     const double t_end = dataset.ground_truth.back().t;
-    setup.model = FeatureTrajectory::Create(options.trajectory, mean, t_begin,
+    setup.model = FeatureTrajectory::Create(options.features, mean, t_begin,
                                             t_end, &error);
     ok = setup.model != nullptr &&
          InitializeLandmarks(
@@ -550,7 +550,7 @@ void BM_FeatureCache(benchmark::State& state) {
   std::size_t distinct = 0;
   for (auto _ : state) {
     state.PauseTiming();
-    auto model = FeatureTrajectory::Create(options.trajectory, mean,
+    auto model = FeatureTrajectory::Create(options.features, mean,
                                            times.front(), times.back(), &error);
     std::vector<PoseMap> maps;
     maps.reserve(times.size());

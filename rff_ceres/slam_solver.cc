@@ -264,7 +264,7 @@ bool RunSlamAtOrigin(const Dataset& dataset, const SlamOptions& options,
                           result->prior_mean == "wnoa" &&
                           options.learn_hyperparameters != "off";
   if (correction) {
-    FeatureTrajectoryOptions& t = settled.trajectory;
+    FeatureTrajectoryOptions& t = settled.features;
     t.position_kernel.variance = std::pow(2.0 * t.capacity_position_sigma, 2);
     t.heading_kernel.variance = std::pow(2.0 * t.capacity_heading_sigma, 2);
     model = CreateTrajectoryModel(dataset, settled, mean, error);
@@ -273,7 +273,7 @@ bool RunSlamAtOrigin(const Dataset& dataset, const SlamOptions& options,
   if (prior.has_features() && options.learn_hyperparameters == "auto" &&
       !search && result->initial_trajectory == "localization") {
     // Drift of dead reckoning: its size from the pilot, its time scale given.
-    MatchVariancesToSpread(*mean, initial, &settled.trajectory);
+    MatchVariancesToSpread(*mean, initial, &settled.features);
     model = CreateTrajectoryModel(dataset, settled, mean, error);
     if (!model || !FitModelToPoses(initial, model.get(), error)) return false;
   }
@@ -284,7 +284,7 @@ bool RunSlamAtOrigin(const Dataset& dataset, const SlamOptions& options,
     const std::vector<TimedPose>& about =
         warm.initial_poses.empty() ? initial : warm.initial_poses;
     if (!LearnHyperparameters(resolved, mean, about, landmarks, settled.problem,
-                              options.learning, &settled.trajectory,
+                              options.learning, &settled.features,
                               &result->learning, error)) {
       *error = "learning the hyperparameters: " + *error;
       return false;

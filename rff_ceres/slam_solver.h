@@ -61,7 +61,8 @@ struct SlamOptions {
   std::map<LandmarkId, Eigen::Vector2d> initial_landmarks;
   // Tuning of the "localization" mean (docs/prior_means.md).
   LocalizationOptions localization;
-  FeatureTrajectoryOptions trajectory;
+  // The RFF prior's features and kernels (FeatureTrajectory).
+  FeatureTrajectoryOptions features;
   // Learn the RFF kernels' lengthscales and variances (batch mode), starting
   // from `trajectory`'s (hyperparameter_learning.h): "on", "off", or "auto",
   // on for data without odometry. With odometry the GP models the drift of

@@ -204,13 +204,13 @@ DatasetSpec SmallSpec(const std::string& name, int seed) {
 
 SlamOptions SmallOptions() {
   SlamOptions options;
-  options.trajectory.family = "hilbert";
-  options.trajectory.num_position_features = 24;
-  options.trajectory.num_heading_features = 24;
-  options.trajectory.position_kernel.lengthscale = 5.0;
-  options.trajectory.position_kernel.variance = 100.0;
-  options.trajectory.heading_kernel = options.trajectory.position_kernel;
-  options.trajectory.heading_kernel.variance = 0.25;
+  options.features.family = "hilbert";
+  options.features.num_position_features = 24;
+  options.features.num_heading_features = 24;
+  options.features.position_kernel.lengthscale = 5.0;
+  options.features.position_kernel.variance = 100.0;
+  options.features.heading_kernel = options.features.position_kernel;
+  options.features.heading_kernel.variance = 0.25;
   options.solver.num_threads = 1;
   return options;
 }
@@ -333,8 +333,8 @@ TEST(RunExperimentTest, VariantsOverrideOptionsAndKeepSolutions) {
   experiment.keep_solutions = true;
   OptionsVariant sparse{"SPARSE_SCHUR qmc D=12", [](SlamOptions* options) {
                           options->solver.linear_solver = "SPARSE_SCHUR";
-                          options->trajectory.family = "qmc";
-                          options->trajectory.num_position_features = 12;
+                          options->features.family = "qmc";
+                          options->features.num_position_features = 12;
                           return true;
                         }};
   OptionsVariant skipped{"never", [](SlamOptions*) { return false; }};

@@ -168,8 +168,8 @@ TEST(LearningRunSlamTest, DefaultSolveLearnsAndReportsTheValues) {
   std::string error;
   ASSERT_TRUE(Simulate(simulation, &dataset, &error)) << error;
   SlamOptions options;
-  options.trajectory.position_kernel.name = "rbf";
-  options.trajectory.heading_kernel.name = "rbf";
+  options.features.position_kernel.name = "rbf";
+  options.features.heading_kernel.name = "rbf";
   SlamResult result;
   ASSERT_TRUE(RunSlam(dataset, options, &result, &error)) << error;
   EXPECT_TRUE(result.learned);

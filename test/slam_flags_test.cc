@@ -47,17 +47,17 @@ TEST(SlamFlagsTest, DefaultFlagsGiveTheLibraryDefaults) {
   EXPECT_EQ(flags.outer_rounds, library.outer_rounds);
   EXPECT_EQ(flags.learn_hyperparameters, library.learn_hyperparameters);
   EXPECT_EQ(flags.spline_smoothing, library.spline_smoothing);
-  const FeatureTrajectoryOptions& t = flags.trajectory;
-  ExpectSameKernel(t.position_kernel, library.trajectory.position_kernel,
+  const FeatureTrajectoryOptions& t = flags.features;
+  ExpectSameKernel(t.position_kernel, library.features.position_kernel,
                    "position kernel");
-  ExpectSameKernel(t.heading_kernel, library.trajectory.heading_kernel,
+  ExpectSameKernel(t.heading_kernel, library.features.heading_kernel,
                    "heading kernel");
-  EXPECT_EQ(t.family, library.trajectory.family);
-  EXPECT_EQ(t.num_position_features, library.trajectory.num_position_features);
-  EXPECT_EQ(t.num_heading_features, library.trajectory.num_heading_features);
-  EXPECT_EQ(t.seed, library.trajectory.seed);
-  EXPECT_EQ(t.segment_length, library.trajectory.segment_length);
-  EXPECT_EQ(t.segment_overlap, library.trajectory.segment_overlap);
+  EXPECT_EQ(t.family, library.features.family);
+  EXPECT_EQ(t.num_position_features, library.features.num_position_features);
+  EXPECT_EQ(t.num_heading_features, library.features.num_heading_features);
+  EXPECT_EQ(t.seed, library.features.seed);
+  EXPECT_EQ(t.segment_length, library.features.segment_length);
+  EXPECT_EQ(t.segment_overlap, library.features.segment_overlap);
   const ProblemOptions& p = flags.problem;
   EXPECT_EQ(p.loss.name, library.problem.loss.name);
   EXPECT_EQ(p.loss.scale, library.problem.loss.scale);

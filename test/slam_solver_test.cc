@@ -377,33 +377,33 @@ INSTANTIATE_TEST_SUITE_P(
     ::testing::Values(
         BadOption{
             "UnknownKernel",
-            [](SlamOptions* o) { o->trajectory.position_kernel.name = "sinc"; },
+            [](SlamOptions* o) { o->features.position_kernel.name = "sinc"; },
             "--kernel=sinc: unknown kernel; allowed rbf, matern12, matern32, "
             "matern52 or periodic"},
         BadOption{"ZeroLengthscale",
                   [](SlamOptions* o) {
-                    o->trajectory.position_kernel.lengthscale = 0.0;
+                    o->features.position_kernel.lengthscale = 0.0;
                   },
                   "--lengthscale=0: allowed more than 0 up to 1e+12"},
         BadOption{"HeadingLengthscaleBeyondDoubles",
                   [](SlamOptions* o) {
-                    o->trajectory.heading_kernel.lengthscale = 1e13;
+                    o->features.heading_kernel.lengthscale = 1e13;
                   },
                   "--heading_lengthscale=1e+13: the features' frequencies and "
                   "weights leave double range; allowed more than 0 up to "
                   "1e+12"},
         BadOption{"UnknownFamily",
-                  [](SlamOptions* o) { o->trajectory.family = "wavelet"; },
+                  [](SlamOptions* o) { o->features.family = "wavelet"; },
                   "--features=wavelet: unknown feature family; allowed rff, "
                   "qmc, gauss_hermite or hilbert"},
         BadOption{
             "NegativeFeatures",
-            [](SlamOptions* o) { o->trajectory.num_position_features = -3; },
+            [](SlamOptions* o) { o->features.num_position_features = -3; },
             "--num_features=-3: allowed 0 (from the capacity rule) to 512"},
         BadOption{"OddHeadingFeaturesOfRff",
                   [](SlamOptions* o) {
-                    o->trajectory.family = "rff";
-                    o->trajectory.num_heading_features = 25;
+                    o->features.family = "rff";
+                    o->features.num_heading_features = 25;
                   },
                   "--num_heading_features=25: rff features come in cos/sin "
                   "pairs; allowed even numbers"},
@@ -436,7 +436,7 @@ INSTANTIATE_TEST_SUITE_P(
                   },
                   "--odometry_loss_scale=0: allowed more than 0"},
         BadOption{"OverlapLongerThanSegment",
-                  [](SlamOptions* o) { o->trajectory.segment_overlap = 60.0; },
+                  [](SlamOptions* o) { o->features.segment_overlap = 60.0; },
                   "--segment_overlap=60: allowed 0 or more, less than "
                   "--segment_length=50"},
         BadOption{"NegativeOuterRounds",
@@ -480,7 +480,7 @@ INSTANTIATE_TEST_SUITE_P(
         BadOption{"KernelCheckedWithTheWnoaPrior",
                   [](SlamOptions* o) {
                     o->prior = "wnoa";
-                    o->trajectory.heading_kernel.name = "sinc";
+                    o->features.heading_kernel.name = "sinc";
                   },
                   "--heading_kernel=sinc: unknown kernel; allowed rbf, "
                   "matern12, matern32, matern52 or periodic"}),
@@ -924,8 +924,8 @@ TEST(LinearSystemSizeTest, DenseSchurIsTwoCopiesOfTheReducedSystem) {
   std::string error;
   ASSERT_TRUE(Simulate(sim, &dataset, &error)) << error;
   SlamOptions options;
-  options.trajectory.num_position_features = 10;
-  options.trajectory.num_heading_features = 10;
+  options.features.num_position_features = 10;
+  options.features.num_heading_features = 10;
   const auto mean = BuildPriorMean("odometry", dataset, &error);
   ASSERT_TRUE(mean) << error;
   options.prior_mean = "odometry";

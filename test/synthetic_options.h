@@ -14,7 +14,7 @@ inline SlamOptions SyntheticRangeBearingOptions() {
   options.prior_mean = "localization";
   // The flags give the kernel hyperparameters, so "auto" learning is off.
   options.learn_hyperparameters = "off";
-  FeatureTrajectoryOptions& t = options.trajectory;
+  FeatureTrajectoryOptions& t = options.features;
   t.position_kernel.name = "rbf";
   t.position_kernel.lengthscale = 5.0;
   t.position_kernel.variance = 100.0;

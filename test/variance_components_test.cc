@@ -346,9 +346,9 @@ TEST(VarianceComponentsTest, RedundanciesMatchTheExactTracesWnoa) {
 TEST(VarianceComponentsTest, RedundanciesMatchTheExactTracesRffDenseRows) {
   SlamOptions options;
   options.prior = "rff";
-  options.trajectory.num_position_features = 20;
-  options.trajectory.num_heading_features = 20;
-  options.trajectory.segment_length = 0.0;
+  options.features.num_position_features = 20;
+  options.features.num_heading_features = 20;
+  options.features.segment_length = 0.0;
   ExpectRedundanciesMatchTheExactTraces(options);
 }
 

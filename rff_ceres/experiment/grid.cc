@@ -204,9 +204,9 @@ std::vector<OptionsVariant> SolverVariants(bool quick) {
             return false;
           }
           options->solver.linear_solver = solver;
-          options->trajectory.family = family;
-          options->trajectory.num_position_features = d;
-          options->trajectory.num_heading_features = d;
+          options->features.family = family;
+          options->features.num_position_features = d;
+          options->features.num_heading_features = d;
           return true;
         };
         variants.push_back(variant);

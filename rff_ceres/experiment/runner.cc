@@ -47,8 +47,8 @@ void SolveAndEvaluate(const Dataset& dataset, const SlamOptions& base,
   const TrajectoryPrior* prior = FindPrior(options.prior);
   const bool has_features = prior != nullptr && prior->has_features();
   if (has_features) {
-    row->features = options.trajectory.family;
-    row->num_features = options.trajectory.num_position_features;
+    row->features = options.features.family;
+    row->num_features = options.features.num_position_features;
   } else {
     // A prior without features: its states are the model.
     row->features = options.prior;

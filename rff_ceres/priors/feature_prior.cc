@@ -14,7 +14,7 @@ class FeaturePriorImpl : public TrajectoryPrior {
 
   bool CheckOptions(const SlamOptions& options,
                     std::string* error) const override {
-    return FeatureTrajectory::Create(options.trajectory, UnitWindowMean(), 0.0,
+    return FeatureTrajectory::Create(options.features, UnitWindowMean(), 0.0,
                                      1.0, error) != nullptr;
   }
 
@@ -23,15 +23,15 @@ class FeaturePriorImpl : public TrajectoryPrior {
       const std::string& /*mean_name*/,
       std::shared_ptr<const MeanFunction> mean,
       std::string* error) const override {
-    return FeatureTrajectory::Create(options.trajectory, std::move(mean),
+    return FeatureTrajectory::Create(options.features, std::move(mean),
                                      DataTimesOf(dataset), error);
   }
 
   double* PositionScale(SlamOptions* options) const override {
-    return &options->trajectory.position_kernel.variance;
+    return &options->features.position_kernel.variance;
   }
   double* HeadingScale(SlamOptions* options) const override {
-    return &options->trajectory.heading_kernel.variance;
+    return &options->features.heading_kernel.variance;
   }
   const char* scales_name() const override { return "variances"; }
 

@@ -221,7 +221,7 @@ TEST_P(RffMatchesExactMapTest, ApeWithinOneCentimetre) {
   options.learn_hyperparameters = "off";
   // The exact reference is the Gaussian model's MAP: no robust loss.
   options.problem.loss = options.problem.odometry_loss = {"none", 1.0};
-  FeatureTrajectoryOptions& t = options.trajectory;
+  FeatureTrajectoryOptions& t = options.features;
   t.position_kernel = exact_options.position_kernel;
   t.heading_kernel = exact_options.heading_kernel;
   t.family = "hilbert";

@@ -49,8 +49,8 @@ TEST(TrajectoryPriorTest, ScalesAreTheOptionsLearningRescales) {
   const TrajectoryPrior& rff = *FindPrior("rff");
   *rff.PositionScale(&options) = 2.0;
   *rff.HeadingScale(&options) = 3.0;
-  EXPECT_EQ(options.trajectory.position_kernel.variance, 2.0);
-  EXPECT_EQ(options.trajectory.heading_kernel.variance, 3.0);
+  EXPECT_EQ(options.features.position_kernel.variance, 2.0);
+  EXPECT_EQ(options.features.heading_kernel.variance, 3.0);
   EXPECT_STREQ(rff.scales_name(), "variances");
   const TrajectoryPrior& wnoa = *FindPrior("wnoa");
   *wnoa.PositionScale(&options) = 4.0;
