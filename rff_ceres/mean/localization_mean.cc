@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "Eigen/Dense"
+#include "ceres/tiny_solver.h"
 #include "costs/bearing_cost.h"
 #include "costs/range_cost.h"
 #include "rff_ceres/dead_reckoning.h"
@@ -13,6 +14,29 @@
 #include "rff_ceres/option_error.h"
 
 namespace rff {
+namespace {
+
+// Ranges below this count as this in the bearing's share of the landmark's
+// spread (s / r), which would otherwise be unbounded at the landmark.
+constexpr double kMinSpreadRange = 1e-6;
+
+// A fix whose information has an eigenvalue below this share of its largest
+// is degenerate (collinear landmarks, parallel bearings): no fix.
+constexpr double kMinInformationRatio = 1e-9;
+
+// The lowest weight a spline point keeps: a point Cauchy-rejected to weight
+// 0 would leave the spline's system singular where it stood alone.
+constexpr double kMinSplineWeight = 1e-12;
+
+// Range-only headings: the direction of motion over a window of 2 x this
+// (seconds), taken only where the robot moved at least kMinHeadingTravel
+// metres in it; each such heading is worth kTravelHeadingVariance (rad^2),
+// and without any the correction is 0 with variance 1.
+constexpr double kHeadingHalfWindow = 5.0;
+constexpr double kMinHeadingTravel = 0.5;
+constexpr double kTravelHeadingVariance = 0.1;
+
+}  // namespace
 
 std::vector<MapResidualRow> MapResiduals(
     const std::vector<Observation>& observations,
@@ -38,22 +62,25 @@ std::vector<MapResidualRow> MapResiduals(
       rows.push_back(row);
     }
     double bearing;
-    if (o.HasBearing() &&
-        BearingAndGradient(p, l.position, &bearing, &d_pose, &d_landmark)) {
-      const double spread = l.sigma / std::max(range, 1e-6);
+    if (!o.HasBearing()) continue;
+    MapResidualRow row;  // Zero where the landmark sits on the robot.
+    if (BearingAndGradient(p, l.position, &bearing, &d_pose, &d_landmark)) {
+      // The landmark's spread seen from range r subtends s / r radians.
+      const double spread = l.sigma / std::max(range, kMinSpreadRange);
       const double sigma =
           std::sqrt(o.sigma_bearing * o.sigma_bearing + spread * spread);
-      MapResidualRow row;
       row.residual = WrapAngle(bearing - o.bearing) / sigma;
       row.jacobian = d_pose.transpose() / sigma;
-      rows.push_back(row);
     }
+    rows.push_back(row);
   }
   return rows;
 }
 
 namespace {
 
+// The heading variance of a fix that did not measure it (range-only, or
+// the heading held): far beyond a turn, so the smoother ignores it.
 constexpr double kUnmeasuredHeadingVariance = 1e6;
 
 double Cost(const std::vector<MapResidualRow>& rows) {
@@ -62,47 +89,84 @@ double Cost(const std::vector<MapResidualRow>& rows) {
   return cost;
 }
 
-// Levenberg-Marquardt from `start` over the free unknowns (`free_heading`
-// false holds theta). Returns the final cost and leaves the pose in `pose`.
+// One pose against the map as a ceres::TinySolver function of its free
+// unknowns: x, y, and theta unless `kFree` is 2 (the heading held at the
+// start's). MapResiduals keeps one row per measured value at every pose.
+template <int kFree>
+class PoseFit {
+ public:
+  using Scalar = double;
+  enum { NUM_RESIDUALS = Eigen::Dynamic, NUM_PARAMETERS = kFree };
+
+  PoseFit(const std::vector<Observation>& observations,
+          const std::map<LandmarkId, KnownLandmark>& landmarks,
+          const Eigen::Vector3d& start)
+      : observations_(observations),
+        landmarks_(landmarks),
+        start_(start),
+        num_rows_(static_cast<int>(
+            MapResiduals(observations, landmarks, start).size())) {}
+
+  int NumResiduals() const { return num_rows_; }
+
+  bool operator()(const double* x, double* residuals, double* jacobian) const {
+    const std::vector<MapResidualRow> rows =
+        MapResiduals(observations_, landmarks_, Pose(x));
+    for (int r = 0; r < num_rows_; ++r) {
+      residuals[r] = rows[r].residual;
+      if (jacobian == nullptr) continue;
+      for (int c = 0; c < kFree; ++c) {
+        jacobian[r + c * num_rows_] = rows[r].jacobian(c);  // Column-major.
+      }
+    }
+    return true;
+  }
+
+  Eigen::Vector3d Pose(const double* x) const {
+    Eigen::Vector3d pose = start_;
+    for (int c = 0; c < kFree; ++c) pose[c] = x[c];
+    return pose;
+  }
+
+ private:
+  const std::vector<Observation>& observations_;
+  const std::map<LandmarkId, KnownLandmark>& landmarks_;
+  const Eigen::Vector3d start_;
+  const int num_rows_;
+};
+
+// A fit of two or three unknowns converges in a few steps from a seed in its
+// basin; the cap only ends a degenerate geometry's slow crawl.
+constexpr int kMaxRefineIterations = 50;
+
+template <int kFree>
+void RefineFree(const std::vector<Observation>& observations,
+                const std::map<LandmarkId, KnownLandmark>& landmarks,
+                Eigen::Vector3d* pose) {
+  const PoseFit<kFree> fit(observations, landmarks, *pose);
+  ceres::TinySolver<PoseFit<kFree>> solver;
+  solver.options.max_num_iterations = kMaxRefineIterations;
+  // Costs are chi-square sums of order the rows: stop at changes and steps
+  // far below any that matters to a fix.
+  solver.options.function_tolerance = 1e-12;
+  solver.options.parameter_tolerance = 1e-12;
+  Eigen::Matrix<double, kFree, 1> x = pose->head<kFree>();
+  solver.Solve(fit, &x);
+  if (x.allFinite()) *pose = fit.Pose(x.data());
+}
+
+// Levenberg-Marquardt (ceres::TinySolver) from `pose` over the free unknowns
+// (`free_heading` false holds theta). Returns the final cost (the sum of
+// squared whitened residuals) and leaves the pose in `pose`.
 double Refine(const std::vector<Observation>& observations,
               const std::map<LandmarkId, KnownLandmark>& landmarks,
               bool free_heading, Eigen::Vector3d* pose) {
-  const int n = free_heading ? 3 : 2;
-  std::vector<MapResidualRow> rows =
-      MapResiduals(observations, landmarks, *pose);
-  double cost = Cost(rows);
-  double lambda = 1e-3;
-  for (int iteration = 0; iteration < 50; ++iteration) {
-    Eigen::Matrix3d h = Eigen::Matrix3d::Zero();
-    Eigen::Vector3d g = Eigen::Vector3d::Zero();
-    for (const MapResidualRow& r : rows) {
-      h += r.jacobian.transpose() * r.jacobian;
-      g += r.jacobian.transpose() * r.residual;
-    }
-    const Eigen::MatrixXd hn = h.topLeftCorner(n, n);
-    Eigen::MatrixXd damped = hn;
-    damped.diagonal() += lambda * (hn.diagonal().array() + 1e-9).matrix();
-    const Eigen::VectorXd step = -damped.ldlt().solve(g.head(n));
-    Eigen::Vector3d candidate = *pose;
-    candidate.head(n) += step;
-    if (!candidate.allFinite()) break;
-    const std::vector<MapResidualRow> next =
-        MapResiduals(observations, landmarks, candidate);
-    const double next_cost = Cost(next);
-    if (next_cost < cost) {
-      const bool small = cost - next_cost < 1e-12 * (1.0 + cost) ||
-                         step.norm() < 1e-12 * (1.0 + pose->head(2).norm());
-      *pose = candidate;
-      rows = next;
-      cost = next_cost;
-      lambda = std::max(lambda / 10.0, 1e-12);
-      if (small) break;
-    } else {
-      lambda *= 10.0;
-      if (lambda > 1e12) break;
-    }
+  if (free_heading) {
+    RefineFree<3>(observations, landmarks, pose);
+  } else {
+    RefineFree<2>(observations, landmarks, pose);
   }
-  return cost;
+  return Cost(MapResiduals(observations, landmarks, *pose));
 }
 
 }  // namespace
@@ -164,7 +228,8 @@ bool LocalizePose(const std::vector<Observation>& observations,
   const Eigen::MatrixXd hn = h.topLeftCorner(unknowns, unknowns);
   Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(hn);
   const Eigen::VectorXd values = eigen.eigenvalues();
-  if (!(values(0) > 1e-9 * values(unknowns - 1)) || !(values(0) > 0.0)) {
+  if (!(values(0) > kMinInformationRatio * values(unknowns - 1)) ||
+      !(values(0) > 0.0)) {
     return false;
   }
   fix->covariance = Eigen::Matrix3d::Zero();
@@ -210,7 +275,7 @@ bool RobustFit(const std::vector<double>& t,
     for (std::size_t k = 0; k < dims; ++k) {
       std::vector<double> w(n);
       for (std::size_t i = 0; i < n; ++i) {
-        w[i] = std::max(robust[i] / variances[k][i], 1e-12);
+        w[i] = std::max(robust[i] / variances[k][i], kMinSplineWeight);
       }
       if (!(*splines)[k].Fit(t, values[k], w, p, error)) return false;
     }
@@ -508,7 +573,7 @@ std::shared_ptr<const MeanFunction> BuildLocalizationMean(
     // Range-only: the heading correction is the turn between the dead
     // reckoned and the corrected direction of motion over a few seconds.
     heading = Series(1);
-    const double half = 5.0;
+    const double half = kHeadingHalfWindow;
     for (const double t : position.t) {
       const Eigen::Vector3d a = dead_reckoning->Evaluate(t - half);
       const Eigen::Vector3d b = dead_reckoning->Evaluate(t + half);
@@ -516,11 +581,13 @@ std::shared_ptr<const MeanFunction> BuildLocalizationMean(
       const Eigen::Vector2d v =
           v_dr + Eigen::Vector2d(at(dxy[0], t + half) - at(dxy[0], t - half),
                                  at(dxy[1], t + half) - at(dxy[1], t - half));
-      if (v_dr.norm() < 0.5 || v.norm() < 0.5) continue;
+      if (v_dr.norm() < kMinHeadingTravel || v.norm() < kMinHeadingTravel) {
+        continue;
+      }
       heading.Add(t,
                   {WrapAngle(std::atan2(v.y(), v.x()) -
                              std::atan2(v_dr.y(), v_dr.x()))},
-                  {0.1});
+                  {kTravelHeadingVariance});
     }
     if (heading.t.empty()) heading.Add(position.t.front(), {0.0}, {1.0});
   }
