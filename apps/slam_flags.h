@@ -6,7 +6,7 @@
 
 #include <string>
 
-#include "rff_ceres/slam_solver.h"
+#include "rff_ceres/options.h"
 
 namespace rff {
 

@@ -8,7 +8,7 @@
 #include <utility>
 #include <vector>
 
-#include "rff_ceres/slam_solver.h"
+#include "rff_ceres/options.h"
 
 namespace rff {
 

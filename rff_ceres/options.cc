@@ -1,5 +1,5 @@
-// ValidateSlamOptions (slam_solver.h): every option checked once, before any
-// file is read or any solve starts, whichever prior it belongs to.
+#include "rff_ceres/options.h"
+
 #include <algorithm>
 #include <cmath>
 #include <memory>
@@ -11,7 +11,6 @@
 #include "rff_ceres/mean/prior_mean.h"
 #include "rff_ceres/option_error.h"
 #include "rff_ceres/priors/trajectory_prior.h"
-#include "rff_ceres/slam_solver.h"
 
 namespace rff {
 namespace {
