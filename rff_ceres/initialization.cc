@@ -12,7 +12,6 @@
 #include "rff_ceres/dead_reckoning.h"
 #include "rff_ceres/mean_rotation.h"
 #include "rff_ceres/se2.h"
-#include "rff_ceres/wnoa_trajectory.h"
 
 namespace rff {
 namespace {
@@ -189,11 +188,8 @@ bool FitModelToPoses(const std::vector<TimedPose>& poses,
     *rotation->mutable_block(0) = 0.0;
     return FitModelToPoses(poses, rotation->inner(), error);
   }
-  if (auto* wnoa = dynamic_cast<WnoaTrajectory*>(model)) {
-    wnoa->SetStatesFromPoses(poses);
-    return true;
-  }
   if (poses.empty()) return true;
+  if (model->SetBlocksFromPoses(poses)) return true;
   // The pose residual wraps the heading: a target more than pi from the
   // model's heading would pull it the wrong way round. The headings are
   // unwrapped along the poses from the model's branch and approached in

@@ -50,8 +50,8 @@ bool BuildPilotTrajectory(const Dataset& dataset,
 
 // Sets the blocks of `model` to the MAP fit of `poses` (sigmas 0.05 m and
 // 0.05 rad) under the model's own prior: the initial value that reproduces a
-// pilot trajectory as closely as the model can. WNOA states are set directly
-// (WnoaTrajectory::SetStatesFromPoses).
+// pilot trajectory as closely as the model can. A model with a rule of its
+// own uses it (TrajectoryModel::SetBlocksFromPoses: WNOA states).
 bool FitModelToPoses(const std::vector<TimedPose>& poses,
                      TrajectoryModel* model, std::string* error);
 

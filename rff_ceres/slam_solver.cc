@@ -163,10 +163,7 @@ bool ReportSolution(const SlamOptions& options,
   result->loss = settled->problem.loss.name;
   result->odometry_loss = settled->problem.odometry_loss.name;
   result->wnoa_options = settled->wnoa;
-  if (const auto* features =
-          dynamic_cast<const FeatureTrajectory*>(InnerModel(&model))) {
-    result->trajectory_options = features->options();
-  }
+  PriorOf(options).RecordModel(model, result);
   if (!problem->CheckLandmarksDetermined(1e12, error)) return false;
   // Judged against the data as stated: learned sigmas would absorb a misfit.
   result->quality = AssessQuality(problem->WhitenedResidualsByKind(

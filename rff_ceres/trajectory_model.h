@@ -63,6 +63,13 @@ class TrajectoryModel {
   // place in the solve does not depend on their address.
   virtual bool IsSharedBlock(int /*block*/) const { return false; }
 
+  // Sets the blocks to follow `poses` (sorted by time, at least one) by a
+  // rule of the model's own, where it has one (states that hold poses);
+  // false leaves them to the generic MAP fit (FitModelToPoses).
+  virtual bool SetBlocksFromPoses(const std::vector<TimedPose>& /*poses*/) {
+    return false;
+  }
+
   // Heading and position at t with the current block values (heading not
   // wrapped: the model's heading is a continuous function of time).
   Eigen::Vector3d Pose(double t) const;

@@ -88,6 +88,10 @@ class WnoaTrajectory : public TrajectoryModel {
   // smoothest under the prior given those positions (one tridiagonal solve
   // per coordinate).
   void SetStatesFromPoses(const std::vector<TimedPose>& poses);
+  bool SetBlocksFromPoses(const std::vector<TimedPose>& poses) override {
+    SetStatesFromPoses(poses);
+    return true;
+  }
 
   // The per-coordinate 2x2 interpolation matrices at `elapsed` = tau - t_i
   // in an interval of length `dt` = t_{i+1} - t_i > 0, in closed form

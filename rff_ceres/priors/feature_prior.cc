@@ -2,6 +2,7 @@
 // with b_k ~ N(0, I) over random Fourier features or a deterministic basis
 // (FeatureTrajectory); its scales are the kernel variances.
 #include "rff_ceres/data_stretches.h"
+#include "rff_ceres/mean_rotation.h"
 #include "rff_ceres/priors/trajectory_prior.h"
 
 namespace rff {
@@ -34,6 +35,14 @@ class FeaturePriorImpl : public TrajectoryPrior {
     return &options->features.heading_kernel.variance;
   }
   const char* scales_name() const override { return "variances"; }
+
+  void RecordModel(const TrajectoryModel& model,
+                   SlamResult* result) const override {
+    if (const auto* features =
+            dynamic_cast<const FeatureTrajectory*>(InnerModel(&model))) {
+      result->trajectory_options = features->options();
+    }
+  }
 
   void PrintModel(const SlamResult& result, std::ostream* out) const override {
     const FeatureTrajectoryOptions& t = result.trajectory_options;

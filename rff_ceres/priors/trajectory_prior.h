@@ -51,6 +51,11 @@ class TrajectoryPrior {
   virtual double* HeadingScale(SlamOptions* options) const = 0;
   virtual const char* scales_name() const = 0;
 
+  // Copies into `result` what the model settled when it was built (a
+  // feature count the capacity rule chose); nothing by default.
+  virtual void RecordModel(const TrajectoryModel& /*model*/,
+                           SlamResult* /*result*/) const {}
+
   // The summary's lines on the model as solved.
   virtual void PrintModel(const SlamResult& result,
                           std::ostream* out) const = 0;
