@@ -56,7 +56,7 @@ int main(int argc, char** argv) {
   if (FLAGS_dataset.empty()) return Fail("--dataset is required");
 
   rff::SlamOptions options = rff::SlamOptionsFromFlags();
-  options.compute_covariance = !FLAGS_output_covariance.empty();
+  options.output.covariance = !FLAGS_output_covariance.empty();
   if (!rff::ValidateSlamOptions(options, &error)) return Fail(error);
   const rff::SlamOutputPaths outputs = {
       FLAGS_output_trajectory, FLAGS_output_landmarks, FLAGS_output_covariance,

@@ -205,8 +205,8 @@ bool KernelHyperparametersGiven() {
 SlamOptions SlamOptionsFromFlags() {
   SlamOptions options;
   options.prior = FLAGS_prior;
-  options.prior_mean = FLAGS_prior_mean;
-  options.initial_trajectory = FLAGS_initial_trajectory;
+  options.mean.name = FLAGS_prior_mean;
+  options.start.trajectory = FLAGS_initial_trajectory;
   LocalizationOptions& localization = options.localization;
   localization.position_smoothing = FLAGS_localization_position_smoothing;
   localization.heading_smoothing = FLAGS_localization_heading_smoothing;
@@ -222,12 +222,12 @@ SlamOptions SlamOptionsFromFlags() {
   w.min_state_spacing = FLAGS_wnoa_min_state_spacing;
   options.incremental.every = FLAGS_incremental_every;
   options.incremental.lag = FLAGS_incremental_lag;
-  options.outer_rounds = FLAGS_outer_rounds;
+  options.mean.outer_rounds = FLAGS_outer_rounds;
   options.learn_hyperparameters = FLAGS_learn_hyperparameters;
   if (options.learn_hyperparameters == "auto" && KernelHyperparametersGiven()) {
     options.learn_hyperparameters = "off";
   }
-  options.spline_smoothing = FLAGS_spline_smoothing;
+  options.mean.spline_smoothing = FLAGS_spline_smoothing;
   FeatureTrajectoryOptions& t = options.features;
   t.position_kernel.name = FLAGS_kernel;
   t.position_kernel.lengthscale = FLAGS_lengthscale;

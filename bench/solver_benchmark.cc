@@ -286,7 +286,7 @@ ProblemSetup& CachedSetup(int n, int d, int l, int segment) {
   std::string error;
   const auto start = std::chrono::steady_clock::now();
   std::shared_ptr<const MeanFunction> mean =
-      BuildPriorMean(options.prior_mean, dataset, &error);
+      BuildPriorMean(options.mean.name, dataset, &error);
   std::map<LandmarkId, Eigen::Vector2d> landmarks;
   bool ok = mean != nullptr;
   if (ok) {
@@ -546,7 +546,7 @@ void BM_FeatureCache(benchmark::State& state) {
   const SlamOptions options = BenchOptions(d, 50, "DENSE_SCHUR");
   std::string error;
   std::shared_ptr<const MeanFunction> mean =
-      BuildPriorMean(options.prior_mean, dataset, &error);
+      BuildPriorMean(options.mean.name, dataset, &error);
   std::size_t distinct = 0;
   for (auto _ : state) {
     state.PauseTiming();

@@ -189,7 +189,7 @@ PyResult Solve(py::handle dataset_or_path, const py::kwargs& kwargs) {
   if (!SlamOptionsFromSettings(settings, &options, &error)) {
     throw py::value_error(error);
   }
-  options.compute_covariance = compute_covariance;
+  options.output.covariance = compute_covariance;
   options.solver.log_progress = verbose;
   if (!ValidateSlamOptions(options, &error)) throw py::value_error(error);
   const PyDataset dataset = DatasetOf(dataset_or_path);
@@ -235,7 +235,7 @@ PyResult Solve(py::handle dataset_or_path, const py::kwargs& kwargs) {
   std::ostringstream summary;
   WriteSummaryJson(options, result.slam, &summary);
   result.summary_json = summary.str();
-  if (options.compute_covariance) {
+  if (options.output.covariance) {
     const SlamResult& slam = result.slam;
     if (slam.pose_covariances.size() != slam.trajectory.size()) {
       throw std::runtime_error(

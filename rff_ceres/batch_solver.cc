@@ -104,11 +104,11 @@ bool SolveBatch(const Dataset& dataset, const SlamOptions& options,
       --round;  // The same round again, about the turned mean.
       continue;
     }
-    if (round >= options.outer_rounds) return true;
+    if (round >= options.mean.outer_rounds) return true;
     std::shared_ptr<const MeanFunction> mean =
         RefitSplineMean(result->trajectory,
                         DataFitWeights(dataset, result->trajectory, *landmarks),
-                        options.spline_smoothing, error);
+                        options.mean.spline_smoothing, error);
     if (!mean) return false;
     model->set_mean(mean);
     for (int b = 0; b < model->num_blocks(); ++b) {

@@ -31,15 +31,15 @@ bool ValidateSlamOptions(const SlamOptions& options, std::string* error) {
   if (!ToCeresOptions(options.solver, &ceres_options, error) ||
       !CheckOneOf(options.prior, "prior", "unknown prior", PriorNames(),
                   error) ||
-      !CheckOneOf(options.prior_mean, "prior_mean", "unknown prior mean",
+      !CheckOneOf(options.mean.name, "prior_mean", "unknown prior mean",
                   PriorMeanNames(), error) ||
       !CheckOneOf(options.learn_hyperparameters, "learn_hyperparameters", "",
                   {"auto", "on", "off"}, error) ||
-      !CheckOneOf(options.initial_trajectory, "initial_trajectory", "",
+      !CheckOneOf(options.start.trajectory, "initial_trajectory", "",
                   {"auto", "mean"}, error)) {
     return false;
   }
-  if (options.prior_mean == "wnoa" && !PriorOf(options).has_features()) {
+  if (options.mean.name == "wnoa" && !PriorOf(options).has_features()) {
     std::vector<std::string> with_features;
     for (const std::string& name : PriorNames()) {
       if (FindPrior(name)->has_features()) with_features.push_back(name);
@@ -53,10 +53,12 @@ bool ValidateSlamOptions(const SlamOptions& options, std::string* error) {
                               error)) {
     return false;
   }
-  if (options.outer_rounds < 0 || options.outer_rounds > kMaxOuterRounds) {
+  if (options.mean.outer_rounds < 0 ||
+      options.mean.outer_rounds > kMaxOuterRounds) {
     *error = OptionError(
-        "outer_rounds", std::to_string(options.outer_rounds),
-        options.outer_rounds > 0 ? "more spline refits than supported" : "",
+        "outer_rounds", std::to_string(options.mean.outer_rounds),
+        options.mean.outer_rounds > 0 ? "more spline refits than supported"
+                                      : "",
         "0 to " + std::to_string(kMaxOuterRounds));
     return false;
   }
@@ -64,9 +66,11 @@ bool ValidateSlamOptions(const SlamOptions& options, std::string* error) {
                               "max_preintegration_seconds", error)) {
     return false;
   }
-  if (!(options.spline_smoothing >= 0.0 && options.spline_smoothing <= 1.0)) {
-    *error = OptionError("spline_smoothing",
-                         FormatNumber(options.spline_smoothing), "", "0 to 1");
+  if (!(options.mean.spline_smoothing >= 0.0 &&
+        options.mean.spline_smoothing <= 1.0)) {
+    *error =
+        OptionError("spline_smoothing",
+                    FormatNumber(options.mean.spline_smoothing), "", "0 to 1");
     return false;
   }
   const IncrementalOptions& incremental = options.incremental;
@@ -78,9 +82,9 @@ bool ValidateSlamOptions(const SlamOptions& options, std::string* error) {
   if (!CheckNonNegativeOption(incremental.lag, "incremental_lag", error)) {
     return false;
   }
-  if (incremental.every > 0 && options.outer_rounds > 0) {
+  if (incremental.every > 0 && options.mean.outer_rounds > 0) {
     *error =
-        OptionError("outer_rounds", std::to_string(options.outer_rounds),
+        OptionError("outer_rounds", std::to_string(options.mean.outer_rounds),
                     "refits the whole run, which the incremental mode "
                     "(--incremental_every=" +
                         std::to_string(incremental.every) + ") does not do",

@@ -40,45 +40,62 @@ inline constexpr std::size_t kMaxCovarianceLandmarks = 10000;
 // Refits of the spline mean stop changing it after a few rounds (III-B.2).
 inline constexpr int kMaxOuterRounds = 100;
 
-struct SlamOptions {
-  // Trajectory prior, by its registry name (priors/trajectory_prior.h):
-  // "rff" (weight-space features) or "wnoa" (LTV-SDE states).
-  std::string prior = "rff";
+// The prior mean mu(t) and the paper's spline rounds about it.
+struct MeanOptions {
   // Prior mean (prior_mean.h). "auto" settles per dataset (SettlePriorMean):
   // for the RFF prior in batch mode with odometry, "wnoa".
-  std::string prior_mean = "auto";
-  // Initial value of the blocks: "auto" fits them to a localisation pilot
-  // (initialization.h) when one can be built; "mean" starts at the mean.
-  std::string initial_trajectory = "auto";
-  // A warm start that overrides initial_trajectory: the blocks are fitted to
-  // these poses (sorted by time) and these landmarks start here (the others
-  // are initialised from their observations as usual).
-  std::vector<TimedPose> initial_poses;
-  std::map<LandmarkId, Eigen::Vector2d> initial_landmarks;
-  // Tuning of the "localization" mean (docs/prior_means.md).
-  LocalizationOptions localization;
-  // The RFF prior's features and kernels (FeatureTrajectory).
-  FeatureTrajectoryOptions features;
-  // Learn the RFF kernels' lengthscales and variances (batch mode), starting
-  // from `trajectory`'s (hyperparameter_learning.h): "on", "off", or "auto",
-  // on for data without odometry. With odometry the GP models the drift of
-  // dead reckoning, which grows along the run: a stationary kernel learned
-  // on a window misjudges it (docs/prior_means.md, "RFF with odometry").
-  // WNOA learns Q_c and the noise scales of the data unless "off".
-  std::string learn_hyperparameters = "auto";
-  LearningOptions learning;
-  WnoaOptions wnoa;
-  ProblemOptions problem;
-  SolverOptions solver;
+  std::string name = "auto";
   // Outer rounds of the paper's smoothing-spline prior (III-B.2): after each
   // solve, refit the mean to the estimate and solve again. 0: one solve; at
   // most kMaxOuterRounds.
   int outer_rounds = 0;
   double spline_smoothing = 0.98;  // De Boor's p.
+};
+
+// Where the solve starts.
+struct StartOptions {
+  // Initial value of the blocks: "auto" fits them to a localisation pilot
+  // (initialization.h) when one can be built; "mean" starts at the mean.
+  std::string trajectory = "auto";
+  // A warm start that overrides `trajectory`: the blocks are fitted to these
+  // poses (sorted by time) and these landmarks start here (the others are
+  // initialised from their observations as usual).
+  std::vector<TimedPose> poses;
+  std::map<LandmarkId, Eigen::Vector2d> landmarks;
+};
+
+// What the solve reports besides the trajectory and the landmarks.
+struct OutputOptions {
   // Posterior covariance of every output pose and landmark (see
   // posterior_covariance.h); for at most kMaxCovarianceLandmarks landmarks.
-  bool compute_covariance = false;
+  bool covariance = false;
+};
+
+struct SlamOptions {
+  // Trajectory prior, by its registry name (priors/trajectory_prior.h):
+  // "rff" (weight-space features) or "wnoa" (LTV-SDE states).
+  std::string prior = "rff";
+  MeanOptions mean;
+  StartOptions start;
+  // Tuning of the "localization" mean and pilot (docs/prior_means.md).
+  LocalizationOptions localization;
+  // The RFF prior's features and kernels (FeatureTrajectory).
+  FeatureTrajectoryOptions features;
+  // Learn the prior's hyperparameters: the RFF kernels' lengthscales and
+  // variances (batch mode), starting from `features`'
+  // (hyperparameter_learning.h): "on", "off", or "auto", on for data without
+  // odometry. With odometry the GP models the drift of dead reckoning, which
+  // grows along the run: a stationary kernel learned on a window misjudges
+  // it (docs/prior_means.md, "RFF with odometry"). WNOA learns Q_c and the
+  // noise scales of the data unless "off".
+  std::string learn_hyperparameters = "auto";
+  LearningOptions learning;
+  WnoaOptions wnoa;
+  // The data's residuals: noise scales, losses, odometry, calibration.
+  ProblemOptions problem;
+  SolverOptions solver;
   IncrementalOptions incremental;
+  OutputOptions output;
 };
 
 // Checks every option, of both priors whatever the chosen one, with the

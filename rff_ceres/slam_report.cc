@@ -202,7 +202,7 @@ void WriteSummaryJson(const SlamOptions& options, const SlamResult& result,
       << JsonString(ceres::TerminationTypeToString(s.termination_type)) << ",\n"
       << "  \"converged\": " << (result.converged ? "true" : "false") << ",\n"
       << "  \"iterations\": " << result.total_iterations << ",\n"
-      << "  \"outer_rounds\": " << options.outer_rounds << ",\n"
+      << "  \"outer_rounds\": " << options.mean.outer_rounds << ",\n"
       << "  \"initial_cost\": " << FormatNumber(s.initial_cost) << ",\n"
       << "  \"final_cost\": " << FormatNumber(s.final_cost) << ",\n"
       << "  \"num_residual_blocks\": " << s.num_residual_blocks << ",\n"

@@ -94,7 +94,7 @@ bool AddMeanCovariance(const SlamResult& mean, SlamResult* result,
 
 std::string SettlePriorMean(const SlamOptions& options,
                             const Dataset& dataset) {
-  if (options.prior_mean != "auto") return options.prior_mean;
+  if (options.mean.name != "auto") return options.mean.name;
   if (dataset.odometry.empty()) return "constant";
   const bool batch = options.incremental.every == 0;
   if (!batch) return "odometry";
@@ -129,7 +129,7 @@ bool CheckData(const Dataset& dataset, const SlamOptions& options,
       return false;
     }
   }
-  if (options.compute_covariance) {
+  if (options.output.covariance) {
     std::set<LandmarkId> ids;
     for (const LandmarkPrior& p : dataset.landmark_priors) ids.insert(p.id);
     for (const Observation& o : dataset.observations) ids.insert(o.id);
@@ -176,7 +176,7 @@ bool ReportSolution(const SlamOptions& options,
     l.y = position.y();
     result->landmarks.push_back(l);
   }
-  if (options.compute_covariance) {
+  if (options.output.covariance) {
     std::vector<double> times;
     for (const TimedPose& p : result->trajectory) times.push_back(p.t);
     CovarianceOptions covariance_options;
@@ -224,7 +224,7 @@ bool RunSlamAtOrigin(const Dataset& dataset, const SlamOptions& options,
   if (!InitializeBlocks(resolved, warm, model.get(), result, error)) {
     return false;
   }
-  if (options.initial_poses.empty() && !warm.initial_poses.empty()) {
+  if (options.start.poses.empty() && !warm.start.poses.empty()) {
     result->initial_trajectory = "wnoa";
   }
 
@@ -237,7 +237,7 @@ bool RunSlamAtOrigin(const Dataset& dataset, const SlamOptions& options,
           error)) {
     return false;
   }
-  for (const auto& [id, position] : warm.initial_landmarks) {
+  for (const auto& [id, position] : warm.start.landmarks) {
     if (landmarks.count(id)) landmarks[id] = position;
   }
   std::vector<TimedPose> initial;
@@ -279,7 +279,7 @@ bool RunSlamAtOrigin(const Dataset& dataset, const SlamOptions& options,
     // where there is one: the fit of the features to it is only as good as
     // their starting hyperparameters.
     const std::vector<TimedPose>& about =
-        warm.initial_poses.empty() ? initial : warm.initial_poses;
+        warm.start.poses.empty() ? initial : warm.start.poses;
     if (!LearnHyperparameters(resolved, mean, about, landmarks, settled.problem,
                               options.learning, &settled.features,
                               &result->learning, error)) {
@@ -354,11 +354,11 @@ bool RunSlam(const Dataset& dataset, const SlamOptions& options,
     return RunSlamAtOrigin(dataset, options, result, error);
   }
   SlamOptions centred = options;
-  for (TimedPose& p : centred.initial_poses) {
+  for (TimedPose& p : centred.start.poses) {
     p.x -= origin.x();
     p.y -= origin.y();
   }
-  for (auto& [id, position] : centred.initial_landmarks) position -= origin;
+  for (auto& [id, position] : centred.start.landmarks) position -= origin;
   if (!RunSlamAtOrigin(Translated(dataset, -origin.x(), -origin.y()), centred,
                        result, error)) {
     return false;

@@ -39,7 +39,7 @@ struct SlamResult {
   // reads the GT times, never the GT poses), headings wrapped.
   std::vector<TimedPose> trajectory;
   std::vector<Landmark> landmarks;  // Sorted by id.
-  // With compute_covariance: the covariance of (x, y, theta) at each
+  // With output.covariance: the covariance of (x, y, theta) at each
   // trajectory time, and has_covariance set on every landmark.
   std::vector<Eigen::Matrix3d> pose_covariances;
   ceres::Solver::Summary summary;          // Of the last solve.

@@ -21,9 +21,9 @@ bool SolveWnoa(const Dataset& dataset, const SlamOptions& options,
                bool covariance, SlamResult* solve, std::string* error) {
   SlamOptions wnoa = options;
   wnoa.prior = WnoaPrior().name();
-  wnoa.prior_mean = "auto";
-  wnoa.outer_rounds = 0;
-  wnoa.compute_covariance = covariance;
+  wnoa.mean.name = "auto";
+  wnoa.mean.outer_rounds = 0;
+  wnoa.output.covariance = covariance;
   // The user's linear solver is for the RFF solve; banded states want their
   // own (AutoLinearSolverType).
   wnoa.solver.linear_solver = "auto";
@@ -37,11 +37,11 @@ bool InitializeBlocks(const Dataset& start, const SlamOptions& options,
                       TrajectoryModel* model, SlamResult* result,
                       std::string* error) {
   result->initial_trajectory = "mean";
-  if (!options.initial_poses.empty()) {
+  if (!options.start.poses.empty()) {
     result->initial_trajectory = "given";
-    return FitModelToPoses(options.initial_poses, model, error);
+    return FitModelToPoses(options.start.poses, model, error);
   }
-  if (options.initial_trajectory == "mean" || result->prior_mean == "wnoa") {
+  if (options.start.trajectory == "mean" || result->prior_mean == "wnoa") {
     return true;
   }
   if (result->prior_mean == "constant" && options.problem.use_odometry &&
@@ -77,11 +77,11 @@ std::shared_ptr<const MeanFunction> BuildMean(
   std::shared_ptr<const MeanFunction> mean;
   if (PriorOf(options).has_features() && options.incremental.every == 0 &&
       (result->prior_mean == "wnoa" ||
-       (dataset.odometry.empty() && options.initial_trajectory == "auto" &&
-        options.initial_poses.empty()))) {
+       (dataset.odometry.empty() && options.start.trajectory == "auto" &&
+        options.start.poses.empty()))) {
     SlamResult wnoa;
     const bool wnoa_mean = result->prior_mean == "wnoa";
-    if (!SolveWnoa(dataset, options, wnoa_mean && options.compute_covariance,
+    if (!SolveWnoa(dataset, options, wnoa_mean && options.output.covariance,
                    &wnoa, error)) {
       return nullptr;
     }
@@ -98,15 +98,15 @@ std::shared_ptr<const MeanFunction> BuildMean(
       mean = std::make_shared<PiecewiseLinearMean>(wnoa.trajectory);
       *wnoa_mean_solve = std::move(wnoa);
     } else {
-      warm->initial_poses = wnoa.trajectory;
+      warm->start.poses = wnoa.trajectory;
       for (const Landmark& l : wnoa.landmarks) {
-        warm->initial_landmarks[l.id] = Eigen::Vector2d(l.x, l.y);
+        warm->start.landmarks[l.id] = Eigen::Vector2d(l.x, l.y);
       }
     }
   }
   if (!mean) {
     mean = BuildPriorMean(result->prior_mean, resolved, options.localization,
-                          options.spline_smoothing, error);
+                          options.mean.spline_smoothing, error);
   }
   return mean;
 }

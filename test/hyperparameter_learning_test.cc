@@ -120,7 +120,7 @@ TEST_P(LearningRecoveryTest, LengthscaleWithinTwentyPercent) {
 
     SlamOptions wnoa_options;
     wnoa_options.prior = "wnoa";
-    wnoa_options.compute_covariance = false;
+    wnoa_options.output.covariance = false;
     SlamResult wnoa;
     ASSERT_TRUE(RunSlam(dataset, wnoa_options, &wnoa, &error)) << error;
     std::map<LandmarkId, Eigen::Vector2d> landmarks;

@@ -344,8 +344,8 @@ TEST(PosteriorCovarianceTest, WnoaRunUsesTheSelectedInverse) {
 // configs/synthetic_range_bearing.flags as SlamOptions.
 SlamOptions SyntheticRangeBearingOptions(int outer_rounds) {
   SlamOptions options = testing::SyntheticRangeBearingOptions();
-  options.outer_rounds = outer_rounds;
-  options.compute_covariance = true;
+  options.mean.outer_rounds = outer_rounds;
+  options.output.covariance = true;
   return options;
 }
 
@@ -479,7 +479,7 @@ TEST(WnoaMeanCovarianceTest, RffCovarianceContainsTheWnoaSolves) {
   std::string error;
   ASSERT_TRUE(Simulate(simulation, &dataset, &error)) << error;
   SlamOptions options;
-  options.compute_covariance = true;
+  options.output.covariance = true;
   SlamResult rff, wnoa;
   ASSERT_TRUE(RunSlam(dataset, options, &rff, &error)) << error;
   ASSERT_EQ(rff.prior_mean, "wnoa");

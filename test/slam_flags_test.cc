@@ -22,8 +22,8 @@ TEST(SlamFlagsTest, DefaultFlagsGiveTheLibraryDefaults) {
   const SlamOptions flags = SlamOptionsFromFlags();
   const SlamOptions library;
   EXPECT_EQ(flags.prior, library.prior);
-  EXPECT_EQ(flags.prior_mean, library.prior_mean);
-  EXPECT_EQ(flags.initial_trajectory, library.initial_trajectory);
+  EXPECT_EQ(flags.mean.name, library.mean.name);
+  EXPECT_EQ(flags.start.trajectory, library.start.trajectory);
   EXPECT_EQ(flags.localization.position_smoothing,
             library.localization.position_smoothing);
   EXPECT_EQ(flags.localization.heading_smoothing,
@@ -44,9 +44,9 @@ TEST(SlamFlagsTest, DefaultFlagsGiveTheLibraryDefaults) {
   EXPECT_EQ(flags.wnoa.min_state_spacing, library.wnoa.min_state_spacing);
   EXPECT_EQ(flags.incremental.every, library.incremental.every);
   EXPECT_EQ(flags.incremental.lag, library.incremental.lag);
-  EXPECT_EQ(flags.outer_rounds, library.outer_rounds);
+  EXPECT_EQ(flags.mean.outer_rounds, library.mean.outer_rounds);
   EXPECT_EQ(flags.learn_hyperparameters, library.learn_hyperparameters);
-  EXPECT_EQ(flags.spline_smoothing, library.spline_smoothing);
+  EXPECT_EQ(flags.mean.spline_smoothing, library.mean.spline_smoothing);
   const FeatureTrajectoryOptions& t = flags.features;
   ExpectSameKernel(t.position_kernel, library.features.position_kernel,
                    "position kernel");

@@ -239,7 +239,7 @@ TEST(SlamSolverTest, RunsFarApartInTimeSolveAsEachAlone) {
   // What the whole run shares is made each run's own: the constant mean
   // (the earliest pose prior), the start (dead reckoning would carry the
   // first run's end into the second: the truth here) and the losses.
-  options.prior_mean = "constant";
+  options.mean.name = "constant";
   options.problem.loss.name = "none";
   options.problem.odometry_loss.name = "none";
   // Converged to rounding: the joint solve takes other steps.
@@ -247,11 +247,11 @@ TEST(SlamSolverTest, RunsFarApartInTimeSolveAsEachAlone) {
   options.solver.gradient_tolerance = 1e-12;
   options.solver.parameter_tolerance = 1e-12;
   SlamResult joint_result, first_result, later_result;
-  options.initial_poses = joint.ground_truth;
+  options.start.poses = joint.ground_truth;
   ASSERT_TRUE(RunSlam(joint, options, &joint_result, &error)) << error;
-  options.initial_poses = first.ground_truth;
+  options.start.poses = first.ground_truth;
   ASSERT_TRUE(RunSlam(first, options, &first_result, &error)) << error;
-  options.initial_poses = later_alone.ground_truth;
+  options.start.poses = later_alone.ground_truth;
   ASSERT_TRUE(RunSlam(later_alone, options, &later_result, &error)) << error;
   // 300 s at 1 Hz in 50 s segments: 6 per run, 3 x 24 weights each.
   EXPECT_EQ(first_result.summary.num_parameters,
@@ -296,7 +296,7 @@ TEST(SlamSolverTest, SplineRoundsKeepTheAccuracy) {
   std::string error;
   ASSERT_TRUE(Simulate(sim, &dataset, &error)) << error;
   SlamOptions options = PaperSolverOptions();
-  options.outer_rounds = 2;
+  options.mean.outer_rounds = 2;
   SlamResult result;
   ASSERT_TRUE(RunSlam(dataset, options, &result, &error)) << error;
   EXPECT_GT(result.total_iterations,
@@ -317,7 +317,7 @@ TEST(SlamSolverTest, NoiseFreeDataIsRecovered) {
   ASSERT_TRUE(Simulate(sim, &dataset, &error)) << error;
   // Start from the localisation mean (smoothed, so not the truth).
   SlamOptions options = PaperSolverOptions();
-  options.prior_mean = "localization";
+  options.mean.name = "localization";
   SlamResult result;
   ASSERT_TRUE(RunSlam(dataset, options, &result, &error)) << error;
   // Relative to the size of the scene (the landmarks' spread).
@@ -440,17 +440,17 @@ INSTANTIATE_TEST_SUITE_P(
                   "--segment_overlap=60: allowed 0 or more, less than "
                   "--segment_length=50"},
         BadOption{"NegativeOuterRounds",
-                  [](SlamOptions* o) { o->outer_rounds = -1; },
+                  [](SlamOptions* o) { o->mean.outer_rounds = -1; },
                   "--outer_rounds=-1: allowed 0 to 100"},
         BadOption{"SplineSmoothingAboveOne",
-                  [](SlamOptions* o) { o->spline_smoothing = 1.5; },
+                  [](SlamOptions* o) { o->mean.spline_smoothing = 1.5; },
                   "--spline_smoothing=1.5: allowed 0 to 1"},
         BadOption{"UnknownPrior", [](SlamOptions* o) { o->prior = "brownian"; },
                   "--prior=brownian: unknown prior; allowed rff or wnoa"},
         BadOption{"WnoaMeanOfTheWnoaPrior",
                   [](SlamOptions* o) {
                     o->prior = "wnoa";
-                    o->prior_mean = "wnoa";
+                    o->mean.name = "wnoa";
                   },
                   "--prior_mean=wnoa: a WNOA-solve mean is for --prior=rff "
                   "only"},
@@ -467,7 +467,7 @@ INSTANTIATE_TEST_SUITE_P(
                   },
                   "--incremental_lag=-2: allowed 0 or more"},
         BadOption{"UnknownPriorMean",
-                  [](SlamOptions* o) { o->prior_mean = "psychic"; },
+                  [](SlamOptions* o) { o->mean.name = "psychic"; },
                   "--prior_mean=psychic: unknown prior mean; allowed auto, "
                   "odometry, wnoa, localization, spline or constant"},
         // Each prior's options are checked whichever prior is chosen.
@@ -496,7 +496,7 @@ TEST(SlamSolverTest, OdometryMeanWithoutOdometryIsAnError) {
   std::string error;
   ASSERT_TRUE(Simulate(sim, &dataset, &error)) << error;
   SlamOptions options = PaperSolverOptions();
-  options.prior_mean = "odometry";
+  options.mean.name = "odometry";
   SlamResult result;
   EXPECT_FALSE(RunSlam(dataset, options, &result, &error));
   EXPECT_THAT(error, HasSubstr("prior mean 'odometry'"));
@@ -511,7 +511,7 @@ TEST(SlamSolverTest, IncrementalModeTracksTheBatchSolution) {
   std::string error;
   ASSERT_TRUE(Simulate(sim, &dataset, &error)) << error;
   SlamOptions options = PaperSolverOptions();
-  options.prior_mean = "odometry";  // No landmark priors to localise against.
+  options.mean.name = "odometry";  // No landmark priors to localise against.
   // The same losses in both: incremental updates keep "auto" robust.
   options.problem.loss.name = options.problem.odometry_loss.name = "cauchy";
   SlamResult batch;
@@ -616,8 +616,8 @@ TEST(SlamSolverTest, RobustOdometryLossRejectsSlippingRecords) {
   // Dead reckoning carries the slips, so the mean comes from localisation
   // and is refitted to the estimate.
   SlamOptions options = PaperSolverOptions();
-  options.prior_mean = "localization";
-  options.outer_rounds = 2;
+  options.mean.name = "localization";
+  options.mean.outer_rounds = 2;
   options.problem.odometry_loss = {"none", 1.0};
   SlamResult plain;
   ASSERT_TRUE(RunSlam(dataset, options, &plain, &error)) << error;
@@ -699,7 +699,7 @@ TEST(SlamSolverTest, IncrementalModeRejectsOuterRounds) {
   ASSERT_TRUE(Simulate(sim, &dataset, &error)) << error;
   SlamOptions options = PaperSolverOptions();
   options.incremental.every = 5;
-  options.outer_rounds = 1;
+  options.mean.outer_rounds = 1;
   SlamResult result;
   EXPECT_FALSE(RunSlam(dataset, options, &result, &error));
   EXPECT_EQ(error,
@@ -798,7 +798,7 @@ TEST(SlamSolverTest, CrowdedLandmarksKeepTheirCovariance) {
   ASSERT_GT(near, 0);
   SlamOptions options;  // The defaults, as rff_slam has them.
   options.prior = "wnoa";
-  options.compute_covariance = true;
+  options.output.covariance = true;
   SlamResult result;
   ASSERT_TRUE(RunSlam(dataset, options, &result, &error)) << error;
   EXPECT_TRUE(result.converged);
@@ -928,7 +928,7 @@ TEST(LinearSystemSizeTest, DenseSchurIsTwoCopiesOfTheReducedSystem) {
   options.features.num_heading_features = 10;
   const auto mean = BuildPriorMean("odometry", dataset, &error);
   ASSERT_TRUE(mean) << error;
-  options.prior_mean = "odometry";
+  options.mean.name = "odometry";
   const auto model = CreateTrajectoryModel(dataset, options, mean, &error);
   ASSERT_TRUE(model) << error;
   std::map<LandmarkId, Eigen::Vector2d> landmarks;

@@ -11,7 +11,7 @@ namespace testing {
 
 inline SlamOptions SyntheticRangeBearingOptions() {
   SlamOptions options;
-  options.prior_mean = "localization";
+  options.mean.name = "localization";
   // The flags give the kernel hyperparameters, so "auto" learning is off.
   options.learn_hyperparameters = "off";
   FeatureTrajectoryOptions& t = options.features;

@@ -217,7 +217,7 @@ TEST_P(RffMatchesExactMapTest, ApeWithinOneCentimetre) {
 
   SlamOptions options;
   options.prior = "rff";
-  options.prior_mean = "constant";
+  options.mean.name = "constant";
   options.learn_hyperparameters = "off";
   // The exact reference is the Gaussian model's MAP: no robust loss.
   options.problem.loss = options.problem.odometry_loss = {"none", 1.0};

@@ -64,7 +64,7 @@ TEST(TrajectoryPriorTest, FactoryBuildsTheNamedModel) {
   const Dataset dataset = TenSeconds();
   const std::shared_ptr<const MeanFunction> mean = ZeroMean();
   SlamOptions options;
-  options.prior_mean = "constant";
+  options.mean.name = "constant";
   std::string error;
   options.prior = "wnoa";
   std::unique_ptr<TrajectoryModel> wnoa =
