@@ -8,6 +8,7 @@
 #include "ceres/tiny_solver.h"
 #include "costs/bearing_cost.h"
 #include "costs/range_cost.h"
+#include "glog/logging.h"
 #include "rff_ceres/dead_reckoning.h"
 #include "rff_ceres/io/text_parser.h"
 #include "rff_ceres/mean/spline_mean.h"
@@ -110,8 +111,15 @@ class PoseFit {
   int NumResiduals() const { return num_rows_; }
 
   bool operator()(const double* x, double* residuals, double* jacobian) const {
+    if (!Pose(x).allFinite()) {
+      // A NaN cost makes TinySolver reject the step (it ignores false).
+      std::fill_n(residuals, num_rows_,
+                  std::numeric_limits<double>::quiet_NaN());
+      return false;
+    }
     const std::vector<MapResidualRow> rows =
         MapResiduals(observations_, landmarks_, Pose(x));
+    DCHECK_EQ(static_cast<int>(rows.size()), num_rows_);
     for (int r = 0; r < num_rows_; ++r) {
       residuals[r] = rows[r].residual;
       if (jacobian == nullptr) continue;

@@ -34,7 +34,9 @@ struct MapResidualRow {
 
 // Whitened residuals of `observations` (landmarks missing from `landmarks`
 // are skipped) at pose `p`: the measurement models of the solver's costs with
-// the landmark's spread added (sigma_r^2 + s^2; sigma_b^2 + (s / r)^2).
+// the landmark's spread added (sigma_r^2 + s^2; sigma_b^2 + (s / r)^2). One
+// row per measured value at every pose (a zero row for a bearing to a
+// landmark on the robot), so the count does not depend on `p`.
 std::vector<MapResidualRow> MapResiduals(
     const std::vector<Observation>& observations,
     const std::map<LandmarkId, KnownLandmark>& landmarks,

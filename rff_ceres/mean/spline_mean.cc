@@ -6,7 +6,6 @@
 #include "Eigen/SparseCholesky"
 #include "Eigen/SparseCore"
 #include "rff_ceres/io/text_parser.h"
-#include "rff_ceres/option_error.h"
 
 namespace rff {
 
@@ -24,7 +23,8 @@ bool CubicSmoothingSpline::Fit(const std::vector<double>& t,
     return false;
   }
   if (!(p >= 0.0 && p <= 1.0)) {
-    *error = OptionError("spline_smoothing", FormatNumber(p), "", "0 to 1");
+    *error = "smoothing spline: smoothing p must be in [0, 1], got " +
+             FormatNumber(p);
     return false;
   }
   for (std::size_t i = 0; i < n; ++i) {

@@ -112,7 +112,7 @@ TEST(CubicSmoothingSplineTest, RejectsBadInput) {
             "smoothing spline: times must increase strictly, but t[2] = 1 <= "
             "1");
   EXPECT_FALSE(spline.Fit({0, 1}, {0, 0}, {1, 1}, 1.5, &error));
-  EXPECT_EQ(error, "--spline_smoothing=1.5: allowed 0 to 1");
+  EXPECT_EQ(error, "smoothing spline: smoothing p must be in [0, 1], got 1.5");
   EXPECT_FALSE(spline.Fit({0, 1}, {0, 0}, {1, 0}, 0.5, &error));
   EXPECT_THAT(error, HasSubstr("point 1"));
   EXPECT_FALSE(spline.Fit({}, {}, {}, 0.5, &error));
