@@ -55,17 +55,24 @@ QualityReport AssessQuality(
     ResidualKindQuality q;
     q.kind = kind;
     q.residuals = static_cast<int>(values.size());
-    int beyond = 0;
+    const double outlier_level = OutlierLevel(q.residuals);
+    int beyond = 0, inliers = 0;
     for (const double r : values) {
       q.chi2_per_residual += r * r;
       q.largest = std::max(q.largest, std::abs(r));
       if (std::abs(r) > 3.0) ++beyond;
+      if (std::abs(r) <= outlier_level) {
+        q.inlier_chi2_per_residual += r * r;
+        ++inliers;
+      }
     }
     q.chi2_per_residual /= q.residuals;
+    if (inliers > 0) q.inlier_chi2_per_residual /= inliers;
     q.share_beyond_3_sigma = static_cast<double>(beyond) / q.residuals;
-    if (q.chi2_per_residual > kMaxChi2PerResidual) {
-      report.reasons.push_back(kind + " chi2/n " + Short(q.chi2_per_residual) +
-                               " > " + Short(kMaxChi2PerResidual));
+    if (q.inlier_chi2_per_residual > kMaxChi2PerResidual) {
+      report.reasons.push_back(kind + " chi2/n " +
+                               Short(q.inlier_chi2_per_residual) +
+                               " (inliers) > " + Short(kMaxChi2PerResidual));
     }
     if (q.share_beyond_3_sigma > kMaxShareBeyond3Sigma &&
         PoissonUpperTail(kNormalBeyond3Sigma * q.residuals, beyond) <

@@ -2,8 +2,11 @@
 // correct model at its MAP are close to N(0, 1): per observation kind the
 // normalised chi-square sum(r^2) / n is near 1 and about 0.27% of them lie
 // beyond 3 sigma. A wrong basin (a mirrored or rotated map, a landmark on
-// the wrong side) shows as a kind far above both. The report gives both per
-// kind and a verdict: "ok", or "suspect" with the reasons.
+// the wrong side) shows as a kind far above both. The chi-square is judged
+// on the inliers (|r| within OutlierLevel): outliers, which a robust loss
+// sets aside, are judged by their share, so a few gross ones among many do
+// not make a good fit "suspect". The report gives both per kind and a
+// verdict: "ok", or "suspect" with the reasons.
 #ifndef RFF_CERES_QUALITY_REPORT_H_
 #define RFF_CERES_QUALITY_REPORT_H_
 
@@ -32,6 +35,8 @@ struct ResidualKindQuality {
   std::string kind;  // "range", "odometry", "landmark prior", ...
   int residuals = 0;
   double chi2_per_residual = 0.0;     // sum(r^2) / n
+  // The same over the inliers, |r| <= OutlierLevel(n); 0 without any.
+  double inlier_chi2_per_residual = 0.0;
   double share_beyond_3_sigma = 0.0;  // |r| > 3, as a fraction
   double largest = 0.0;               // max |r|
 };

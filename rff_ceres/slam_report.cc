@@ -115,9 +115,9 @@ void PrintSlamSummary(const SlamOptions& options, const SlamResult& result,
   }
   *out << "\n  residuals   ";
   for (const ResidualKindQuality& q : result.quality.kinds) {
-    *out << " " << q.kind << " chi2/n " << q.chi2_per_residual << " ("
-         << 100.0 * q.share_beyond_3_sigma << "% > 3 sigma, largest "
-         << q.largest << ");";
+    *out << " " << q.kind << " chi2/n " << q.chi2_per_residual << " (inliers "
+         << q.inlier_chi2_per_residual << ", " << 100.0 * q.share_beyond_3_sigma
+         << "% > 3 sigma, largest " << q.largest << ");";
   }
   *out << "\n  quality      " << QualityLine(result.quality) << "\n";
   if (!result.converged) {
@@ -234,6 +234,8 @@ void WriteSummaryJson(const SlamOptions& options, const SlamResult& result,
     out << (i == 0 ? "\n" : ",\n") << "    " << JsonString(q.kind)
         << ": {\"count\": " << q.residuals
         << ", \"chi2_per_residual\": " << FormatNumber(q.chi2_per_residual)
+        << ", \"inlier_chi2_per_residual\": "
+        << FormatNumber(q.inlier_chi2_per_residual)
         << ", \"share_beyond_3_sigma\": "
         << FormatNumber(q.share_beyond_3_sigma)
         << ", \"largest\": " << FormatNumber(q.largest) << "}";
