@@ -5,6 +5,8 @@
 #include <iomanip>
 #include <sstream>
 
+#include "rff_ceres/measurement_types.h"
+
 namespace rff {
 namespace {
 
@@ -69,10 +71,13 @@ QualityReport AssessQuality(
     q.chi2_per_residual /= q.residuals;
     if (inliers > 0) q.inlier_chi2_per_residual /= inliers;
     q.share_beyond_3_sigma = static_cast<double>(beyond) / q.residuals;
-    if (q.inlier_chi2_per_residual > kMaxChi2PerResidual) {
-      report.reasons.push_back(kind + " chi2/n " +
-                               Short(q.inlier_chi2_per_residual) +
-                               " (inliers) > " + Short(kMaxChi2PerResidual));
+    const bool sensor = FindMeasurementKind(kind) != nullptr;
+    const double judged =
+        sensor ? q.inlier_chi2_per_residual : q.chi2_per_residual;
+    if (judged > kMaxChi2PerResidual) {
+      report.reasons.push_back(kind + " chi2/n " + Short(judged) +
+                               (sensor ? " (inliers)" : "") + " > " +
+                               Short(kMaxChi2PerResidual));
     }
     if (q.share_beyond_3_sigma > kMaxShareBeyond3Sigma &&
         PoissonUpperTail(kNormalBeyond3Sigma * q.residuals, beyond) <

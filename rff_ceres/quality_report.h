@@ -2,11 +2,14 @@
 // correct model at its MAP are close to N(0, 1): per observation kind the
 // normalised chi-square sum(r^2) / n is near 1 and about 0.27% of them lie
 // beyond 3 sigma. A wrong basin (a mirrored or rotated map, a landmark on
-// the wrong side) shows as a kind far above both. The chi-square is judged
-// on the inliers (|r| within OutlierLevel): outliers, which a robust loss
-// sets aside, are judged by their share, so a few gross ones among many do
-// not make a good fit "suspect". The report gives both per kind and a
-// verdict: "ok", or "suspect" with the reasons.
+// the wrong side) shows as a kind far above both. A sensor's kinds
+// (measurement_types.h) are judged on the chi-square of their inliers (|r|
+// within OutlierLevel) and on the share of their outliers: gross outliers
+// of data association, which a robust loss sets aside, do not make a good
+// fit "suspect" while they are few. The other kinds (odometry, priors) are
+// judged on all their residuals: a motion model broken by hundreds of
+// sigma at a few places is a wrong solution. The report gives both per kind
+// and a verdict: "ok", or "suspect" with the reasons.
 #ifndef RFF_CERES_QUALITY_REPORT_H_
 #define RFF_CERES_QUALITY_REPORT_H_
 

@@ -64,9 +64,9 @@ TEST(QualityReportTest, ResidualsThreeTimesTheirSigmaAreSuspect) {
   EXPECT_THAT(QualityLine(report), HasSubstr("suspect: range chi2/n "));
 }
 
-// Gross outliers that a robust loss sets aside (1% at 30 sigma) raise the
-// raw chi-square to 10 but leave the inliers' at 1: the fit is what its
-// sigmas promise, and the share of outliers is under the bound.
+// Gross outliers of a sensor that a robust loss sets aside (1% at 30 sigma)
+// raise the raw chi-square to 10 but leave the inliers' at 1: the fit is
+// what its sigmas promise, and the share of outliers is under the bound.
 TEST(QualityReportTest, FewGrossOutliersAmongManyLeaveTheFitOk) {
   std::vector<double> values = StandardNormal(5000, 1.0, 3);
   for (int i = 0; i < 50; ++i) values[100 * i] = (i % 2 ? 30.0 : -30.0);
@@ -74,6 +74,10 @@ TEST(QualityReportTest, FewGrossOutliersAmongManyLeaveTheFitOk) {
   EXPECT_EQ(report.verdict, "ok") << QualityLine(report);
   EXPECT_GT(report.kinds[0].chi2_per_residual, 9.0);
   EXPECT_NEAR(report.kinds[0].inlier_chi2_per_residual, 1.0, 0.06);
+  // Odometry is judged on all its residuals: links broken by 30 sigma are
+  // a wrong solution however few.
+  EXPECT_EQ(AssessQuality({{"odometry", values}}, SolveFacts()).verdict,
+            "suspect");
   // Sigmas 2.5 times too small are still suspect.
   std::vector<double> wide = StandardNormal(5000, 2.5, 4);
   EXPECT_EQ(AssessQuality({{"range", wide}}, SolveFacts()).verdict, "suspect");
