@@ -14,14 +14,18 @@ namespace rff {
 namespace {
 
 // Where the turn of the mean's start has grown beyond its first-order form
-// (kMaxRotationLinearization), applies it exactly and returns true: the
-// problem is then solved again about the turned mean.
+// (kMaxRotationLinearization) at the times of `trajectory`, applies it
+// exactly and returns true: the problem is then solved again about the
+// turned mean.
 constexpr double kMaxRotationLinearization = 0.01;  // m
 bool FoldMeanRotation(TrajectoryModel* model,
-                      const std::vector<double>& times) {
+                      const std::vector<TimedPose>& trajectory) {
   auto* rotation = dynamic_cast<MeanRotationTrajectory*>(model);
-  if (rotation == nullptr ||
-      rotation->LinearizationError(times) <= kMaxRotationLinearization) {
+  if (rotation == nullptr) return false;
+  std::vector<double> times;
+  times.reserve(trajectory.size());
+  for (const TimedPose& p : trajectory) times.push_back(p.t);
+  if (rotation->LinearizationError(times) <= kMaxRotationLinearization) {
     return false;
   }
   VLOG(1) << "turning the mean by " << rotation->delta() << " rad";
@@ -100,7 +104,7 @@ bool SolveBatch(const Dataset& dataset, const SlamOptions& options,
                            error)) {
       return false;
     }
-    if (FoldMeanRotation(model, OutputTimes(dataset))) {
+    if (FoldMeanRotation(model, result->trajectory)) {
       --round;  // The same round again, about the turned mean.
       continue;
     }

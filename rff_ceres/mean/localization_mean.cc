@@ -111,14 +111,15 @@ class PoseFit {
   int NumResiduals() const { return num_rows_; }
 
   bool operator()(const double* x, double* residuals, double* jacobian) const {
-    if (!Pose(x).allFinite()) {
+    const Eigen::Vector3d pose = Pose(x);
+    if (!pose.allFinite()) {
       // A NaN cost makes TinySolver reject the step (it ignores false).
       std::fill_n(residuals, num_rows_,
                   std::numeric_limits<double>::quiet_NaN());
       return false;
     }
     const std::vector<MapResidualRow> rows =
-        MapResiduals(observations_, landmarks_, Pose(x));
+        MapResiduals(observations_, landmarks_, pose);
     DCHECK_EQ(static_cast<int>(rows.size()), num_rows_);
     for (int r = 0; r < num_rows_; ++r) {
       residuals[r] = rows[r].residual;
