@@ -7,9 +7,11 @@
 #ifndef RFF_CERES_OPTION_ERROR_H_
 #define RFF_CERES_OPTION_ERROR_H_
 
+#include <algorithm>
 #include <cmath>
 #include <initializer_list>
 #include <string>
+#include <vector>
 
 #include "rff_ceres/io/text_parser.h"  // FormatNumber, for the values.
 
@@ -41,6 +43,19 @@ inline bool CheckNonNegativeOption(double value, const char* flag,
   *error = OptionError(flag, FormatNumber(value),
                        std::isfinite(value) ? "" : "not a finite number",
                        "0 or more");
+  return false;
+}
+
+// `value` must be one of `allowed`; otherwise `error` names the flag, says
+// `what` is wrong ("unknown prior") and lists the allowed values.
+inline bool CheckOneOf(const std::string& value, const char* flag,
+                       const char* what,
+                       const std::vector<std::string>& allowed,
+                       std::string* error) {
+  if (std::find(allowed.begin(), allowed.end(), value) != allowed.end()) {
+    return true;
+  }
+  *error = OptionError(flag, value, what, JoinAlternatives(allowed));
   return false;
 }
 

@@ -13,18 +13,6 @@
 #include "rff_ceres/priors/trajectory_prior.h"
 
 namespace rff {
-namespace {
-
-bool CheckOneOf(const std::string& value, const char* flag, const char* what,
-                const std::vector<std::string>& allowed, std::string* error) {
-  if (std::find(allowed.begin(), allowed.end(), value) != allowed.end()) {
-    return true;
-  }
-  *error = OptionError(flag, value, what, JoinAlternatives(allowed));
-  return false;
-}
-
-}  // namespace
 
 bool ValidateSlamOptions(const SlamOptions& options, std::string* error) {
   ceres::Solver::Options ceres_options;

@@ -25,10 +25,8 @@ std::shared_ptr<const MeanFunction> BuildPriorMean(
     const std::string& name, const Dataset& dataset,
     const LocalizationOptions& localization, double spline_smoothing,
     std::string* error) {
-  const std::vector<std::string> names = PriorMeanNames();
-  if (std::find(names.begin(), names.end(), name) == names.end()) {
-    *error = OptionError("prior_mean", name, "unknown prior mean",
-                         JoinAlternatives(PriorMeanNames()));
+  if (!CheckOneOf(name, "prior_mean", "unknown prior mean", PriorMeanNames(),
+                  error)) {
     return nullptr;
   }
   // Checked whatever the name: "auto" and "spline" may localise.

@@ -5,7 +5,6 @@
 
 #include "glog/logging.h"
 #include "rff_ceres/initialization.h"
-#include "rff_ceres/io/text_parser.h"
 #include "rff_ceres/mean_rotation.h"
 #include "rff_ceres/option_error.h"
 
@@ -53,15 +52,14 @@ std::vector<std::string> PriorNames() {
 std::unique_ptr<TrajectoryModel> CreateTrajectoryModel(
     const Dataset& dataset, const SlamOptions& options,
     std::shared_ptr<const MeanFunction> mean, std::string* error) {
-  const TrajectoryPrior* prior = FindPrior(options.prior);
-  if (prior == nullptr) {
-    *error = OptionError("prior", options.prior, "unknown prior",
-                         JoinAlternatives(PriorNames()));
+  if (!CheckOneOf(options.prior, "prior", "unknown prior", PriorNames(),
+                  error)) {
     return nullptr;
   }
+  const TrajectoryPrior& prior = PriorOf(options);
   const std::string mean_name = SettlePriorMean(options, dataset);
   std::unique_ptr<TrajectoryModel> model =
-      prior->CreateModel(dataset, options, mean_name, mean, error);
+      prior.CreateModel(dataset, options, mean_name, mean, error);
   if (!model || mean_name != "odometry") return model;
   // Dead reckoning carries the error of its start heading: let it turn.
   const PosePrior& start = EarliestPosePrior(dataset);

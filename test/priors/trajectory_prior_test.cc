@@ -11,12 +11,6 @@
 namespace rff {
 namespace {
 
-// A mean at the origin.
-std::shared_ptr<const MeanFunction> ZeroMean() {
-  return std::make_shared<PiecewiseLinearMean>(
-      std::vector<TimedPose>{{0.0, 0.0, 0.0, 0.0}});
-}
-
 // Ten seconds of range records to one landmark, the start pinned.
 Dataset TenSeconds() {
   Dataset dataset;
@@ -62,7 +56,7 @@ TEST(TrajectoryPriorTest, ScalesAreTheOptionsLearningRescales) {
 
 TEST(TrajectoryPriorTest, FactoryBuildsTheNamedModel) {
   const Dataset dataset = TenSeconds();
-  const std::shared_ptr<const MeanFunction> mean = ZeroMean();
+  const std::shared_ptr<const MeanFunction> mean = UnitWindowMean();
   SlamOptions options;
   options.mean.name = "constant";
   std::string error;
@@ -83,7 +77,7 @@ TEST(TrajectoryPriorTest, UnknownPriorIsAnOptionError) {
   SlamOptions options;
   options.prior = "brownian";
   std::string error;
-  EXPECT_EQ(CreateTrajectoryModel(TenSeconds(), options, ZeroMean(), &error),
+  EXPECT_EQ(CreateTrajectoryModel(TenSeconds(), options, UnitWindowMean(), &error),
             nullptr);
   EXPECT_EQ(error, "--prior=brownian: unknown prior; allowed rff or wnoa");
 }
