@@ -44,6 +44,23 @@ std::string Trim(const std::string& text) {
   return text.substr(begin, text.find_last_not_of(blanks) - begin + 1);
 }
 
+// gflags's --fromenv and --tryfromenv read the flags they name from
+// FLAGS_<name> environment variables; a flagfile read that way would pass
+// every check here unseen.
+bool CheckFromEnvironment(const std::string& name, const std::string& value,
+                          std::string* error) {
+  if (name != "fromenv" && name != "tryfromenv") return true;
+  for (const std::string& flag : SplitCommas(value)) {
+    if (flag == "flagfile") {
+      *error = OptionError(name, value,
+                           "a flagfile from the environment is not checked",
+                           "--flagfile=PATH instead");
+      return false;
+    }
+  }
+  return true;
+}
+
 bool CheckFlagfile(const std::string& path, const FlagIsKnown& is_known,
                    const FlagLineVisitor& on_flag,
                    std::vector<std::string>* open,
@@ -88,6 +105,10 @@ bool CheckFlagfile(const std::string& path, const FlagIsKnown& is_known,
           where + "expected --name=value, got '" + text.substr(0, 80) + "'";
       return false;
     }
+    if (!CheckFromEnvironment(name, FlagValue(text), error)) {
+      *error = where + *error;
+      return false;
+    }
     if (name == "flagfile") {
       for (const std::string& nested : SplitCommas(FlagValue(text))) {
         if (!CheckFlagfile(nested, is_known, on_flag, open, read, error)) {
@@ -113,11 +134,16 @@ bool CheckFlagfiles(const std::vector<std::string>& args,
                     std::vector<std::string>* read) {
   for (std::size_t i = 0; i < args.size(); ++i) {
     if (args[i] == "--") break;
-    if (FlagName(args[i]) != "flagfile") continue;
+    const std::string name = FlagName(args[i]);
+    if (name != "flagfile" && name != "fromenv" && name != "tryfromenv") {
+      continue;
+    }
     std::string list = FlagValue(args[i]);
     if (args[i].find('=') == std::string::npos && i + 1 < args.size()) {
       list = args[++i];
     }
+    if (!CheckFromEnvironment(name, list, error)) return false;
+    if (name != "flagfile") continue;
     for (const std::string& path : SplitCommas(list)) {
       std::vector<std::string> open;
       if (!CheckFlagfile(path, is_known, on_flag, &open, read, error)) {

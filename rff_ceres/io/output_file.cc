@@ -1,5 +1,6 @@
 #include "rff_ceres/io/output_file.h"
 
+#include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -57,20 +58,36 @@ std::string PathError(const NamedPath& p, const std::string& why,
   return OptionError(flag, path, why, allowed);
 }
 
+// Outputs are first written to this file beside their path.
+constexpr char kTemporarySuffix[] = ".tmp.XXXXXX";
+
+std::string TemporaryPattern(const std::string& path) {
+  return path + kTemporarySuffix;
+}
+
 bool CheckDirectory(const NamedPath& output, std::string* error) {
   std::error_code ec;
-  if (fs::is_directory(output.path, ec)) {
+  const fs::file_status status = fs::status(output.path, ec);
+  if (fs::is_directory(status)) {
     *error = PathError(output, "a directory", "a file path");
+    return false;
+  }
+  // Renaming a new file over a device or a pipe would replace it.
+  if (fs::exists(status) && !fs::is_regular_file(status)) {
+    *error = PathError(output, "not a regular file (a device, pipe or socket)",
+                       "a regular file path: the output replaces the file");
     return false;
   }
   // Longer names fail only when the file is opened, after the work.
   const std::string name = fs::path(output.path).filename().string();
-  if (name.size() > NAME_MAX) {
+  const std::size_t max_name = NAME_MAX - (sizeof(kTemporarySuffix) - 1);
+  if (name.size() > max_name) {
     *error = PathError(
         output,
         "the file name is " + std::to_string(name.size()) + " characters long",
-        "at most " + std::to_string(NAME_MAX) +
-            " characters, as the file system allows");
+        "at most " + std::to_string(max_name) +
+            " characters (the file system's " + std::to_string(NAME_MAX) +
+            " less the temporary name's suffix)");
     return false;
   }
   fs::path directory = fs::path(output.path).parent_path();
@@ -82,12 +99,18 @@ bool CheckDirectory(const NamedPath& output, std::string* error) {
                                                          : "does not exist"));
     return false;
   }
-  if (access(directory.c_str(), W_OK | X_OK) != 0) {
+  // A trial temporary file, as Open makes it: permission bits alone miss
+  // read-only file systems and directories that even root cannot write.
+  std::string trial = TemporaryPattern(output.path);
+  const int fd = mkstemp(trial.data());
+  if (fd < 0) {
     *error =
         PathError(output, "directory '" + directory.string() +
                               "' is not writable: " + std::strerror(errno));
     return false;
   }
+  close(fd);
+  std::remove(trial.c_str());
   return true;
 }
 
@@ -154,16 +177,22 @@ bool OutputFile::Open(std::string* error) {
     *error = path_ + ": cannot open for writing: is a directory";
     return false;
   }
-  std::string name = path_ + ".tmp.XXXXXX";
+  std::string name = TemporaryPattern(path_);
   const int fd = mkstemp(name.data());
   if (fd < 0) {
     *error = path_ + ": cannot open for writing: " + std::strerror(errno);
     return false;
   }
-  // mkstemp creates the file 0600; give it the mode a new file would get.
-  const mode_t mask = umask(0);
-  umask(mask);
-  fchmod(fd, 0666 & ~mask);
+  // mkstemp creates the file 0600; give it the mode of the file it replaces,
+  // or the one a new file would get.
+  struct stat old_file;
+  if (stat(path_.c_str(), &old_file) == 0 && S_ISREG(old_file.st_mode)) {
+    fchmod(fd, old_file.st_mode & 07777);
+  } else {
+    const mode_t mask = umask(0);
+    umask(mask);
+    fchmod(fd, 0666 & ~mask);
+  }
   close(fd);
   temporary_ = name;
   stream_.open(temporary_, std::ios::out | std::ios::trunc);
@@ -188,6 +217,17 @@ bool OutputFile::Close(std::string* error) {
   if (!written || stream_.fail()) {
     *error = path_ +
              ": write failed: " + std::strerror(written ? errno : write_errno) +
+             "; the file was left as it was";
+    Discard();
+    return false;
+  }
+  // On disk before the rename: a crash then leaves the old file or the new.
+  const int fd = open(temporary_.c_str(), O_RDONLY);
+  const bool synced = fd >= 0 && fsync(fd) == 0;
+  const int sync_errno = errno;
+  if (fd >= 0) close(fd);
+  if (!synced) {
+    *error = path_ + ": write failed: " + std::strerror(sync_errno) +
              "; the file was left as it was";
     Discard();
     return false;

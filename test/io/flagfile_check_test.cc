@@ -55,6 +55,21 @@ TEST(FlagfileCheckTest, SelfInclusionIsAnError) {
                 "flagfiles");
 }
 
+// gflags would read FLAGS_flagfile from the environment unchecked.
+TEST(FlagfileCheckTest, AFlagfileFromTheEnvironmentIsAnError) {
+  const std::string why =
+      ": a flagfile from the environment is not checked; allowed "
+      "--flagfile=PATH instead";
+  EXPECT_EQ(Check({"--fromenv=flagfile"}), "--fromenv=flagfile" + why);
+  EXPECT_EQ(Check({"--tryfromenv", "prior,flagfile"}),
+            "--tryfromenv=prior,flagfile" + why);
+  EXPECT_EQ(Check({"--fromenv=prior"}), "ok");
+  const std::string dir = TempDir("FlagfileCheckTest");
+  WriteFile(dir + "/env.flags", "--prior=rff\n--tryfromenv=flagfile\n");
+  EXPECT_EQ(Check({"--flagfile=" + dir + "/env.flags"}),
+            dir + "/env.flags:2: --tryfromenv=flagfile" + why);
+}
+
 TEST(FlagfileCheckTest, TheSameFileTwiceWithoutACycleIsFine) {
   const std::string dir = TempDir("FlagfileCheckTest");
   WriteFile(dir + "/common.flags", "--prior=rff\n");

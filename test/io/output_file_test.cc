@@ -1,6 +1,7 @@
 #include "rff_ceres/io/output_file.h"
 
 #include <sys/resource.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -172,12 +173,48 @@ TEST(CheckOutputPathsTest, ChecksTheDirectoryBeforeAnyWork) {
   EXPECT_FALSE(CheckOutputPaths({}, {{"--o", dir}}, &error));
   EXPECT_EQ(error, "--o=" + dir + ": a directory; allowed a file path");
   EXPECT_TRUE(CheckOutputPaths({}, {{"--o", dir + "/o.txt"}}, &error)) << error;
-  // A name longer than the file system allows fails here, not after a solve.
-  const std::string long_name(300, 'x');
-  EXPECT_FALSE(CheckOutputPaths({}, {{"--o", long_name}}, &error));
-  EXPECT_EQ(error, "--o=" + long_name.substr(0, 200) +
-                       "...: the file name is 300 characters long; allowed "
-                       "at most 255 characters, as the file system allows");
+  // A name longer than the file system allows once the temporary file's
+  // suffix is added fails here, not after a solve; the check leaves nothing.
+  const std::string long_name(250, 'x');
+  EXPECT_FALSE(CheckOutputPaths({}, {{"--o", dir + "/" + long_name}}, &error));
+  EXPECT_EQ(error, "--o=" + (dir + "/" + long_name).substr(0, 200) +
+                       "...: the file name is 250 characters long; allowed "
+                       "at most 244 characters (the file system's 255 less "
+                       "the temporary name's suffix)");
+  const std::string longest(244, 'x');
+  EXPECT_TRUE(CheckOutputPaths({}, {{"--o", dir + "/" + longest}}, &error))
+      << error;
+  EXPECT_EQ(CountFiles(dir), 1);
+}
+
+// Renaming over a device or a pipe would replace it with a plain file.
+TEST(CheckOutputPathsTest, RefusesWhatIsNotARegularFile) {
+  const std::string dir = TempDir("CheckOutputPathsTest");
+  ASSERT_EQ(mkfifo((dir + "/pipe").c_str(), 0600), 0);
+  std::string error;
+  EXPECT_FALSE(CheckOutputPaths({}, {{"--o", dir + "/pipe"}}, &error));
+  EXPECT_EQ(error, "--o=" + dir +
+                       "/pipe: not a regular file (a device, pipe or "
+                       "socket); allowed a regular file path: the output "
+                       "replaces the file");
+  EXPECT_FALSE(CheckOutputPaths({}, {{"--o", "/dev/null"}}, &error));
+  EXPECT_TRUE(std::filesystem::is_fifo(dir + "/pipe"));
+}
+
+// A replaced file keeps its permissions.
+TEST(OutputFileTest, CommitKeepsTheModeOfTheFileItReplaces) {
+  const std::string dir = TempDir("OutputFileTest");
+  WriteFile(dir + "/private.txt", "old\n");
+  ASSERT_EQ(chmod((dir + "/private.txt").c_str(), 0600), 0);
+  std::string error;
+  ASSERT_TRUE(WriteOutputFile(
+      dir + "/private.txt", [](std::ostream* out) { *out << "new\n"; },
+      &error))
+      << error;
+  struct stat written;
+  ASSERT_EQ(stat((dir + "/private.txt").c_str(), &written), 0);
+  EXPECT_EQ(written.st_mode & 07777, 0600u);
+  EXPECT_EQ(ReadFile(dir + "/private.txt"), "new\n");
 }
 
 }  // namespace
