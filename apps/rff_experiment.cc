@@ -112,6 +112,11 @@ int main(int argc, char** argv) {
   if (!rff::ParseToolFlags(&argc, &argv, &error)) return Fail(error);
   google::InitGoogleLogging(argv[0]);
   if (FLAGS_out_dir.empty()) return Fail("--out_dir is required");
+  // The command line's solver options underlie every method's flagfile:
+  // checked once here, not row by row after the grid has started.
+  if (!rff::ValidateSlamOptions(rff::SlamOptionsFromFlags(), &error)) {
+    return Fail(error);
+  }
 
   const std::string root = FindSourceRoot(argv[0]);
   std::string configs_dir = FLAGS_configs_dir;
@@ -198,5 +203,10 @@ int main(int argc, char** argv) {
             << " failed; wrote";
   for (const std::string& file : summary.files) std::cout << " " << file;
   std::cout << "\n";
+  if (failed > 0) {
+    return Fail(std::to_string(failed) + " of " +
+                std::to_string(summary.rows.size()) +
+                " runs failed (their messages are in runs.csv)");
+  }
   return 0;
 }

@@ -1,5 +1,7 @@
 #include "rff_ceres/experiment/experiment.h"
 
+#include <sys/wait.h>
+
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -18,6 +20,7 @@ namespace {
 
 using ::testing::ElementsAre;
 using ::testing::HasSubstr;
+using ::testing::Not;
 using ::testing::StartsWith;
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
@@ -390,15 +393,20 @@ TEST(GridTest, QuickAndFullGridSizes) {
 }
 
 // The quick preset through the app, as a user runs it: every output file,
-// real numbers, and a method without configs as failed rows.
+// real numbers, and a method without configs as failed rows (and exit
+// status 1).
 TEST(RffExperimentAppTest, QuickPresetWritesEveryTableAndPlot) {
   const std::string dir = testing::TempDir("experiment_test");
   const std::string command =
       std::string(RFF_BINARY_DIR) + "/rff_experiment --quick --out_dir=" + dir +
       " --methods=rff,missing=" + dir +
       "/none/{family}.flags --num_threads=2 2> " + dir + "/stderr.txt";
-  ASSERT_EQ(std::system(command.c_str()), 0)
-      << testing::ReadFile(dir + "/stderr.txt");
+  const int status = std::system(command.c_str());
+  ASSERT_TRUE(WIFEXITED(status));
+  ASSERT_EQ(WEXITSTATUS(status), 1) << testing::ReadFile(dir + "/stderr.txt");
+  EXPECT_THAT(testing::ReadFile(dir + "/stderr.txt"),
+              HasSubstr("rff_experiment: error: 50 of 162 runs failed (their "
+                        "messages are in runs.csv)\n"));
   for (const char* name :
        {"table1.csv", "table1.md", "figure1_noise.svg", "figure1_landmarks.svg",
         "table2.csv", "table2.md", "figure2_trajectory.svg", "figure2_ape.svg",
@@ -527,6 +535,14 @@ TEST(RffExperimentAppTest, BadFlagsExitWithAMessage) {
                         "method gpslam; allowed a comma list of rff, wnoa or "
                         "name=flagfile-pattern (e.g. "
                         "mine=configs/{family}_mine.flags)\n"));
+  // A solver option out of range stops the tool before the grid starts.
+  const std::string bad_option = binary + " --out_dir=" + dir +
+                                 " --num_features=30000 2> " + dir +
+                                 "/err.txt";
+  EXPECT_NE(std::system(bad_option.c_str()), 0);
+  EXPECT_THAT(testing::ReadFile(dir + "/err.txt"),
+              HasSubstr("rff_experiment: error: --num_features=30000: "));
+  EXPECT_THAT(testing::ReadFile(dir + "/err.txt"), Not(HasSubstr("[1/")));
 }
 
 }  // namespace
