@@ -43,17 +43,25 @@ void WriteJsonSummary(const std::string& key, const ErrorSummary& summary,
           << ", \"count\": " << summary.count << "}";
 }
 
+// A table cell 12 wide: fixed point while it fits, else exponent form.
+std::string Cell(double value) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof(buffer),
+                std::abs(value) < 1e6 ? " %12.6f" : " %12.6g", value);
+  return buffer;
+}
+
 void PrintRow(const std::string& name, const ErrorSummary& summary,
               std::ostream* output) {
   char buffer[256];
+  const int width = std::snprintf(buffer, 64, "%-20s", name.c_str());
   if (!summary.available) {
-    std::snprintf(buffer, sizeof(buffer), "%-20s  n/a (", name.c_str());
-    *output << buffer << summary.reason << ")\n";
+    *output << buffer << "  n/a (" << summary.reason << ")\n";
     return;
   }
-  std::snprintf(buffer, sizeof(buffer),
-                "%-20s %12.6f %12.6f %12.6f %12.6f %7d\n", name.c_str(),
-                summary.rms, summary.mean, summary.median, summary.max,
+  std::snprintf(buffer + width, sizeof(buffer) - width, "%s%s%s%s %7d\n",
+                Cell(summary.rms).c_str(), Cell(summary.mean).c_str(),
+                Cell(summary.median).c_str(), Cell(summary.max).c_str(),
                 summary.count);
   *output << buffer;
 }

@@ -368,5 +368,19 @@ TEST(MetricsTest, TableShowsEveryMetric) {
                         "given)\n"));
 }
 
+// Errors too large for a fixed-point cell keep the table's columns.
+TEST(MetricsTest, TableShowsHugeErrorsInExponentForm) {
+  std::vector<TimedPose> estimate = ThreePoses();
+  for (TimedPose& p : estimate) p.x += 1e200;
+  Evaluation e;
+  std::string error;
+  ASSERT_TRUE(Evaluate(ThreePoses(), {}, estimate, nullptr, {}, &e, &error));
+  std::ostringstream table;
+  PrintEvaluation(e, &table);
+  EXPECT_THAT(table.str(),
+              HasSubstr("APE translation [m]        1e+200       1e+200       "
+                        "1e+200       1e+200       3\n"));
+}
+
 }  // namespace
 }  // namespace rff
