@@ -1,6 +1,8 @@
 #include "rff_ceres/io/dataset_io.h"
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 #include <fstream>
 #include <map>
 #include <set>
@@ -108,6 +110,22 @@ class DatasetParser {
     return true;
   }
 
+  // A measurement's sigma is positive and no finer than double precision
+  // resolves its value (m or rad, at least 1): below that its weight only
+  // overflows the normal equations.
+  bool Resolvable(double sigma, double value, const char* what,
+                  const char* quantity) {
+    if (!Positive(sigma, what)) return false;
+    const double resolution =
+        std::numeric_limits<double>::epsilon() * std::max(std::abs(value), 1.0);
+    if (sigma < resolution) {
+      return Fail(std::string(what) + " " + FormatNumber(sigma) +
+                  " is finer than double precision resolves its " + quantity +
+                  "; allowed at least " + FormatNumber(resolution));
+    }
+    return true;
+  }
+
   bool ParseHeader(const std::vector<std::string_view>& fields) {
     if (seen_header_) return Fail("second RFFD header");
     if (fields[1] != "1") {
@@ -183,10 +201,12 @@ class DatasetParser {
     }
     // A noisy range may be negative (a Gaussian measurement of a short
     // distance): it is data, not an error.
-    if (obs.HasRange() && !Positive(obs.sigma_range, "sigma_range")) {
+    if (obs.HasRange() && !Resolvable(obs.sigma_range, obs.range,
+                                      "sigma_range", "range")) {
       return false;
     }
-    if (obs.HasBearing() && !Positive(obs.sigma_bearing, "sigma_bearing")) {
+    if (obs.HasBearing() && !Resolvable(obs.sigma_bearing, obs.bearing,
+                                        "sigma_bearing", "bearing")) {
       return false;
     }
     dataset_->observations.push_back(obs);
@@ -269,6 +289,24 @@ bool ParseDataset(std::istream* input, const std::string& source,
     return false;
   }
   ParseMetadata(reader.leading_comments(), dataset);
+
+  // Every time is finite, but the solver works with their differences.
+  double first = dataset->pose_priors.front().pose.t, last = first;
+  auto span = [&](double t) {
+    first = std::min(first, t);
+    last = std::max(last, t);
+  };
+  for (const PosePrior& p : dataset->pose_priors) span(p.pose.t);
+  for (const Odometry& o : dataset->odometry) span(o.t0), span(o.t1);
+  for (const Observation& o : dataset->observations) span(o.t);
+  for (const TimedPose& p : dataset->ground_truth) span(p.t);
+  if (!std::isfinite(last - first)) {
+    *error = source + ": the records' times run from " + FormatNumber(first) +
+             " to " + FormatNumber(last) +
+             " s, a span beyond double range; allowed times whose "
+             "differences are finite";
+    return false;
+  }
 
   // Records may come in any order: sort them once here.
   SortRecords(dataset);

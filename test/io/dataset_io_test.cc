@@ -120,6 +120,16 @@ const BadCase kBadCases[] = {
      ":2: sigma must be > 0, got -1"},
     {"NegativeZeroSigma", "RFFD 1\nBEARING 1 2 0.1 -0\n",
      ":2: sigma_bearing must be > 0, got -0"},
+    {"SigmaBelowDoubleResolution", "RFFD 1\nRANGE 1 2 3 1e-100\n",
+     ":2: sigma_range 1e-100 is finer than double precision resolves its "
+     "range; allowed at least 6.661338147750939e-16"},
+    {"BearingSigmaBelowDoubleResolution", "RFFD 1\nBEARING 1 2 0.1 1e-300\n",
+     ":2: sigma_bearing 1e-300 is finer than double precision resolves its "
+     "bearing; allowed at least 2.220446049250313e-16"},
+    {"SpanBeyondDoubleRange",
+     "RFFD 1\nPRIOR_POSE -1e308 0 0 0 1 1\nRANGE 1e308 2 3 1\n",
+     "test.rffd: the records' times run from -1e+308 to 1e+308 s, a span "
+     "beyond double range; allowed times whose differences are finite"},
     {"OdometryBackwards", "RFFD 1\nODOM 2 1 0 0 0 1 1 1\n",
      ":2: ODOM needs t1 > t0"},
     {"OdometryZeroLength", "RFFD 1\nODOM 1 1 0 0 0 1 1 1\n",
