@@ -59,11 +59,18 @@ double SegmentCount(double segment_length, double duration) {
 struct StretchLayout {
   double covered = 0.0;  // Seconds, summed over the stretches.
   std::string what;      // "the run's 10 s", with the number of stretches.
+  std::string scope;     // " for this run", or empty for any run.
 };
 
-StretchLayout Describe(const std::vector<double>& lengths) {
+// `any_run`: the lengths are the check of options before the data.
+StretchLayout Describe(const std::vector<double>& lengths, bool any_run) {
   StretchLayout layout;
   for (const double length : lengths) layout.covered += length;
+  if (any_run) {
+    layout.what = "any run of " + FormatNumber(layout.covered) + " s or more";
+    return layout;
+  }
+  layout.scope = " for this run";
   layout.what = lengths.size() == 1 ? "the run's " : "the data's ";
   layout.what += FormatNumber(layout.covered) + " s";
   if (lengths.size() > 1) {
@@ -117,10 +124,25 @@ std::unique_ptr<FeatureTrajectory> FeatureTrajectory::Create(
   return Create(options, std::move(mean), times, error);
 }
 
+bool FeatureTrajectory::CheckOptions(const FeatureTrajectoryOptions& options,
+                                     std::shared_ptr<const MeanFunction> mean,
+                                     std::string* error) {
+  DataTimes times;
+  times.constraints.push_back({0.0, 1.0});
+  return Build(options, std::move(mean), times, true, error) != nullptr;
+}
+
 std::unique_ptr<FeatureTrajectory> FeatureTrajectory::Create(
-    const FeatureTrajectoryOptions& requested,
+    const FeatureTrajectoryOptions& options,
     std::shared_ptr<const MeanFunction> mean, const DataTimes& times,
     std::string* error) {
+  return Build(options, std::move(mean), times, false, error);
+}
+
+std::unique_ptr<FeatureTrajectory> FeatureTrajectory::Build(
+    const FeatureTrajectoryOptions& requested,
+    std::shared_ptr<const MeanFunction> mean, const DataTimes& times,
+    bool any_run, std::string* error) {
   for (const auto& [d, name] :
        {std::pair(requested.num_position_features, "num_features"),
         std::pair(requested.num_heading_features, "num_heading_features")}) {
@@ -167,7 +189,7 @@ std::unique_ptr<FeatureTrajectory> FeatureTrajectory::Create(
   for (const TimeInterval& stretch : stretches) {
     lengths.push_back(std::max(stretch.end - stretch.begin, kShortestStretch));
   }
-  const StretchLayout layout = Describe(lengths);
+  const StretchLayout layout = Describe(lengths, any_run);
   if (requested.segment_length > 0.0 &&
       !(layout.covered / requested.segment_length <= kMaxSegments)) {
     *error = OptionError(
@@ -175,7 +197,7 @@ std::unique_ptr<FeatureTrajectory> FeatureTrajectory::Create(
         "cuts " + layout.what + " into more than " +
             std::to_string(kMaxSegments) + " segments",
         "0 or at least " + FormatNumber(layout.covered / kMaxSegments) +
-            " for this run");
+            layout.scope);
     return nullptr;
   }
   // Each stretch settles its capacity as a run of its length would; many
@@ -213,18 +235,26 @@ std::unique_ptr<FeatureTrajectory> FeatureTrajectory::Create(
     // Fewer segments of these features, or as many of fewer features.
     const double shortest_segment =
         layout.covered / std::floor(kMaxPriorNonZeros / widest_segment_weights);
-    if (requested.num_position_features == kAutoCapacity) {
+    if (requested.num_position_features == kAutoCapacity &&
+        requested.segment_length == 0.0) {
+      // Automatic segments follow the lengthscale: that is the cause.
+      *error = OptionError(
+          "lengthscale", FormatNumber(requested.position_kernel.lengthscale),
+          why + " (automatic segments of " +
+              FormatNumber(kSegmentLengthscales) + " lengthscales)",
+          "a longer lengthscale, or --segment_length of at least " +
+              FormatNumber(shortest_segment) + layout.scope);
+    } else if (requested.num_position_features == kAutoCapacity) {
       *error = OptionError(
           "segment_length", FormatNumber(requested.segment_length), why,
-          "at least " + FormatNumber(shortest_segment) + " for this run");
+          "at least " + FormatNumber(shortest_segment) + layout.scope);
     } else {
       const double most_features = std::floor(
           std::sqrt(kMaxPriorNonZeros / (3.0 * num_segments_needed)));
       *error = OptionError(
           "num_features", std::to_string(requested.num_position_features), why,
-          "at most " + FormatNumber(most_features) +
-              " (as many for theta) for this run, or --segment_length of at "
-              "least " +
+          "at most " + FormatNumber(most_features) + " (as many for theta)" +
+              layout.scope + ", or --segment_length of at least " +
               FormatNumber(shortest_segment));
     }
     return nullptr;

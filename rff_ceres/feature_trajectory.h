@@ -99,6 +99,12 @@ class FeatureTrajectory : public TrajectoryModel {
       const FeatureTrajectoryOptions& options,
       std::shared_ptr<const MeanFunction> mean, double t_begin, double t_end,
       std::string* error);
+  // Checks `options` before any data are read, as Create over a run of
+  // 1 s about `mean`: its size limits then speak of any run (each run is
+  // checked again with its own times).
+  static bool CheckOptions(const FeatureTrajectoryOptions& options,
+                           std::shared_ptr<const MeanFunction> mean,
+                           std::string* error);
 
   int num_blocks() const override {
     return static_cast<int>(offsets_.size()) - 1;
@@ -130,6 +136,11 @@ class FeatureTrajectory : public TrajectoryModel {
   }
 
  private:
+  // Create; `any_run`: `times` stand for any run (CheckOptions).
+  static std::unique_ptr<FeatureTrajectory> Build(
+      const FeatureTrajectoryOptions& options,
+      std::shared_ptr<const MeanFunction> mean, const DataTimes& times,
+      bool any_run, std::string* error);
   FeatureTrajectory() = default;
 
   // Data times close together, with segments numbered [first_segment,

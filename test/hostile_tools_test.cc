@@ -166,8 +166,16 @@ const HostileCase kHostileCases[] = {
      "--num_features too\n",
      "{dir}/out.tum"},
     {"SegmentOverflowingInt", SLAM "--segment_length=1e-10" OUT,
-     "rff_slam: error: --segment_length=1e-10: cuts the run's 1 s into more "
-     "than 100000 segments; allowed 0 or at least 1e-05 for this run\n",
+     "rff_slam: error: --segment_length=1e-10: cuts any run of 1 s or more "
+     "into more than 100000 segments; allowed 0 or at least 1e-05\n",
+     "{dir}/out.tum"},
+    // Automatic segments follow the lengthscale, the option at fault.
+    {"LengthscaleTooShortForTheRun", SLAM "--lengthscale=1e-6" OUT,
+     "rff_slam: error: {dir}/valid.rffd: --lengthscale=1e-06: the run's 10 s "
+     "need 1e+06 segments of 24 features (x, y) and 26 (theta): more "
+     "weights than memory allows (automatic segments of 10 lengthscales); "
+     "allowed a longer lengthscale, or --segment_length of at least "
+     "9.140015903627673e-05 for this run\n",
      "{dir}/out.tum"},
     {"SegmentsOverTheRun",
      SLAM "--segment_length=1e-5 --linear_solver=SPARSE_NORMAL_CHOLESKY" OUT,

@@ -15,8 +15,8 @@ class FeaturePriorImpl : public TrajectoryPrior {
 
   bool CheckOptions(const SlamOptions& options,
                     std::string* error) const override {
-    return FeatureTrajectory::Create(options.features, UnitWindowMean(), 0.0,
-                                     1.0, error) != nullptr;
+    return FeatureTrajectory::CheckOptions(options.features, UnitWindowMean(),
+                                           error);
   }
 
   std::unique_ptr<TrajectoryModel> CreateModel(
