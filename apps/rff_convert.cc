@@ -111,8 +111,8 @@ void PrintRecordCounts(const rff::Dataset& d) {
               d.ground_truth_landmarks.size());
 }
 
-bool ConvertPlaza(rff::Dataset* dataset, std::string* error) {
-  rff::PlazaOptions options;
+bool PlazaOptionsFromFlags(rff::PlazaOptions* plaza, std::string* error) {
+  rff::PlazaOptions& options = *plaza;
   options.name = FLAGS_plaza_name;
   if (!rff::ParsePlazaCalibration(FLAGS_plaza_calibration, &options.calibration,
                                   error)) {
@@ -141,6 +141,11 @@ bool ConvertPlaza(rff::Dataset* dataset, std::string* error) {
     options.first_pose_sigma_xy = FLAGS_prior_sigma_xy;
   }
   options.first_pose_sigma_theta = FLAGS_prior_sigma_theta;
+  return true;
+}
+
+bool ConvertPlaza(const rff::PlazaOptions& options, rff::Dataset* dataset,
+                  std::string* error) {
   rff::PlazaSummary s;
   if (!rff::ConvertPlaza(FLAGS_input, options, dataset, &s, error)) {
     return false;
@@ -168,7 +173,7 @@ bool ConvertPlaza(rff::Dataset* dataset, std::string* error) {
   return true;
 }
 
-bool ConvertMrclam(rff::Dataset* dataset, std::string* error) {
+rff::MrclamOptions MrclamOptionsFromFlags() {
   rff::MrclamOptions options;
   options.robot = FLAGS_mrclam_robot;
   options.odometry_interval = FLAGS_mrclam_odometry_interval;
@@ -184,6 +189,11 @@ bool ConvertMrclam(rff::Dataset* dataset, std::string* error) {
   }
   options.first_pose_sigma_theta = FLAGS_prior_sigma_theta;
   options.gt_rate_hz = FLAGS_gt_rate_hz;
+  return options;
+}
+
+bool ConvertMrclam(const rff::MrclamOptions& options, rff::Dataset* dataset,
+                   std::string* error) {
   rff::MrclamSummary s;
   if (!rff::ConvertMrclam(FLAGS_input, options, dataset, &s, error)) {
     return false;
@@ -331,12 +341,22 @@ int main(int argc, char** argv) {
                              {{"--output", FLAGS_output}}, &error)) {
     return Fail(error);
   }
+  // Every converter's options are checked, used or not, before any work.
+  rff::PlazaOptions plaza;
+  rff::MrclamOptions mrclam = MrclamOptionsFromFlags();
+  // Robot 0 is "not given", which only --format=mrclam refuses.
+  if (format != "mrclam" && mrclam.robot == 0) mrclam.robot = 1;
+  if (!PlazaOptionsFromFlags(&plaza, &error) ||
+      !rff::CheckPlazaOptions(plaza, &error) ||
+      !rff::CheckMrclamOptions(mrclam, &error)) {
+    return Fail(error);
+  }
   rff::Dataset dataset;
   bool ok;
   if (format == "plaza") {
-    ok = ConvertPlaza(&dataset, &error);
+    ok = ConvertPlaza(plaza, &dataset, &error);
   } else if (format == "mrclam") {
-    ok = ConvertMrclam(&dataset, &error);
+    ok = ConvertMrclam(mrclam, &dataset, &error);
   } else if (format == "pyfg") {
     ok = ReadPyfgFile(&dataset, &error);
   } else if (format == "g2o") {

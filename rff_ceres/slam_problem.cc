@@ -42,10 +42,11 @@ bool CreateLoss(const LossOptions& options, const std::string& flag,
                 std::unique_ptr<ceres::LossFunction>* loss,
                 std::string* error) {
   loss->reset();
-  if (options.name == "none") return true;
+  // Checked with "none" too: a value given is checked, used or not.
   if (!CheckPositiveOption(options.scale, (flag + "_scale").c_str(), error)) {
     return false;
   }
+  if (options.name == "none") return true;
   if (options.name == "huber") {
     loss->reset(new ceres::HuberLoss(options.scale));
   } else if (options.name == "cauchy" || options.name == "auto") {

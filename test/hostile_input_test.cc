@@ -206,16 +206,18 @@ TEST(HostileRffdAcceptedTest, NegativeZeroIsData) {
 }
 
 // Numbers are read with strtod: a leading '+', hexadecimal floats and
-// denormals are valid numbers (the writer never produces them).
+// denormals are valid numbers (the writer never produces them); a sigma
+// must still be one double precision resolves (dataset_io_test).
 TEST(HostileRffdAcceptedTest, StrtodSyntaxIsAccepted) {
   Dataset d;
   std::string error;
-  ASSERT_TRUE(ParseRffd(std::string(kHead) + "RANGE +1 2 0x1.8p3 4.9e-324\n",
+  ASSERT_TRUE(ParseRffd(std::string(kHead) + "RANGE +1 2 4.9e-324 0x1.8p3\n",
                         &d, &error))
       << error;
   EXPECT_EQ(d.observations[0].t, 1.0);
-  EXPECT_EQ(d.observations[0].range, 12.0);
-  EXPECT_GT(d.observations[0].sigma_range, 0.0);
+  EXPECT_GT(d.observations[0].range, 0.0);
+  EXPECT_LT(d.observations[0].range, 1e-323);
+  EXPECT_EQ(d.observations[0].sigma_range, 12.0);
 }
 
 // Ids: INT64_MAX is the largest; leading zeros are decimal, not octal.

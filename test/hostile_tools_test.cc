@@ -226,7 +226,35 @@ const HostileCase kHostileCases[] = {
      "rff_convert: error: --prior_sigma_xy=nan: not a finite number; "
      "allowed more than 0\n",
      "{dir}/o.rffd"},
+    // Options of a mode not in use are checked all the same.
+    {"ConvertInactiveFormatOption",
+     "{bin}/rff_convert --to=g2o --input={dir}/valid.rffd --output={dir}/o.g2o "
+     "--mrclam_bearing_sigma=nan",
+     "rff_convert: error: --mrclam_bearing_sigma=nan: not a finite number; "
+     "allowed more than 0\n",
+     "{dir}/o.g2o"},
+    {"ConvertPriorSigmaNaNToG2o",
+     "{bin}/rff_convert --to=g2o --input={dir}/valid.rffd --output={dir}/o.g2o "
+     "--prior_sigma_xy=nan",
+     "rff_convert: error: --prior_sigma_xy=nan: not a finite number; "
+     "allowed more than 0\n",
+     "{dir}/o.g2o"},
+    {"LossScaleWithoutLoss", SLAM "--loss=none --loss_scale=nan" OUT,
+     "rff_slam: error: --loss_scale=nan: not a finite number; allowed more "
+     "than 0\n",
+     "{dir}/out.tum"},
+    {"OdometryLossScaleWithoutLoss",
+     SLAM "--odometry_loss=none --odometry_loss_scale=-1" OUT,
+     "rff_slam: error: --odometry_loss_scale=-1: allowed more than 0\n",
+     "{dir}/out.tum"},
+    {"PeriodOfAnotherKernel", SLAM "--kernel=rbf --period=nan" OUT,
+     "rff_slam: error: --period=nan: ",
+     "{dir}/out.tum"},
     // Flagfiles.
+    {"EnvironmentFlagfile", SLAM "--fromenv=flagfile" OUT,
+     "rff_slam: error: --fromenv=flagfile: a flagfile from the environment is "
+     "not checked; allowed --flagfile=PATH instead\n",
+     "{dir}/out.tum"},
     {"SlamSelfIncludingFlagfile", SLAM "--flagfile={dir}/self.flags" OUT,
      "rff_slam: error: --flagfile={dir}/self.flags: includes itself",
      "{dir}/out.tum"},

@@ -258,7 +258,9 @@ std::string ConverterDescription(const MrclamOptions& o) {
          " --gt_rate_hz=" + n(o.gt_rate_hz);
 }
 
-bool CheckOptions(const MrclamOptions& o, std::string* error) {
+}  // namespace
+
+bool CheckMrclamOptions(const MrclamOptions& o, std::string* error) {
   if (o.robot < 1 || o.robot > kLastRobotSubject) {
     *error = OptionError("mrclam_robot", std::to_string(o.robot), "",
                          "1 to " + std::to_string(kLastRobotSubject));
@@ -290,14 +292,12 @@ bool CheckOptions(const MrclamOptions& o, std::string* error) {
       error);
 }
 
-}  // namespace
-
 bool ConvertMrclam(const std::string& directory, const MrclamOptions& options,
                    Dataset* dataset, MrclamSummary* summary,
                    std::string* error) {
   *dataset = Dataset();
   *summary = MrclamSummary();
-  if (!CheckOptions(options, error)) return false;
+  if (!CheckMrclamOptions(options, error)) return false;
   const std::string robot =
       directory + "/Robot" + std::to_string(options.robot);
   MrclamRaw raw;

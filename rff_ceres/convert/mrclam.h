@@ -71,6 +71,10 @@ struct MrclamSummary {
   MrclamAgreement agreement;
 };
 
+// Whether `options` are valid ("--flag=value: why" in `error`);
+// ConvertMrclam checks them first, and tools may check them before any work.
+bool CheckMrclamOptions(const MrclamOptions& options, std::string* error);
+
 // Reads DIRECTORY/RobotN_*.dat, Barcodes.dat, Landmark_Groundtruth.dat and
 // fills `dataset`. Returns false with "path:line: problem" on malformed input
 // or a missing file.

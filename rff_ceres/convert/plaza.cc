@@ -455,33 +455,6 @@ std::string ConverterDescription(const PlazaOptions& o) {
          " --prior_sigma_theta=" + n(o.first_pose_sigma_theta);
 }
 
-bool CheckOptions(const PlazaOptions& o, std::string* error) {
-  if (o.name.empty()) {
-    *error = OptionError("plaza_name", o.name, "empty",
-                         "a file prefix such as Plaza1");
-    return false;
-  }
-  if (o.heading_offset && !std::isfinite(*o.heading_offset)) {
-    *error =
-        OptionError("plaza_heading_offset", FormatNumber(*o.heading_offset), "",
-                    "auto or a finite number [rad]");
-    return false;
-  }
-  return CheckNumericOptions(
-      {{o.outlier_threshold, "plaza_outlier_threshold", false},
-       {o.range_sigma, "plaza_range_sigma", true},
-       {o.odometry_sigma_xy_floor, "plaza_odom_sigma_xy_floor", false},
-       {o.odometry_sigma_xy_per_metre, "plaza_odom_sigma_xy_per_m", true},
-       {o.odometry_sigma_theta_floor, "plaza_odom_sigma_theta_floor", false},
-       {o.odometry_sigma_theta_per_radian, "plaza_odom_sigma_theta_per_rad",
-        true},
-       {o.landmark_prior_sigma, "plaza_landmark_prior_sigma", true},
-       {o.first_pose_sigma_xy, "prior_sigma_xy", false},
-       {o.first_pose_sigma_theta, "prior_sigma_theta", false},
-       {o.heading_offset_tolerance, "plaza_heading_offset_tolerance", false}},
-      error);
-}
-
 }  // namespace
 
 bool ParsePlazaCalibration(const std::string& text,
@@ -554,11 +527,38 @@ bool FitLinearRangeCalibration(const std::vector<double>& measured,
   return true;
 }
 
+bool CheckPlazaOptions(const PlazaOptions& o, std::string* error) {
+  if (o.name.empty()) {
+    *error = OptionError("plaza_name", o.name, "empty",
+                         "a file prefix such as Plaza1");
+    return false;
+  }
+  if (o.heading_offset && !std::isfinite(*o.heading_offset)) {
+    *error =
+        OptionError("plaza_heading_offset", FormatNumber(*o.heading_offset), "",
+                    "auto or a finite number [rad]");
+    return false;
+  }
+  return CheckNumericOptions(
+      {{o.outlier_threshold, "plaza_outlier_threshold", false},
+       {o.range_sigma, "plaza_range_sigma", true},
+       {o.odometry_sigma_xy_floor, "plaza_odom_sigma_xy_floor", false},
+       {o.odometry_sigma_xy_per_metre, "plaza_odom_sigma_xy_per_m", true},
+       {o.odometry_sigma_theta_floor, "plaza_odom_sigma_theta_floor", false},
+       {o.odometry_sigma_theta_per_radian, "plaza_odom_sigma_theta_per_rad",
+        true},
+       {o.landmark_prior_sigma, "plaza_landmark_prior_sigma", true},
+       {o.first_pose_sigma_xy, "prior_sigma_xy", false},
+       {o.first_pose_sigma_theta, "prior_sigma_theta", false},
+       {o.heading_offset_tolerance, "plaza_heading_offset_tolerance", false}},
+      error);
+}
+
 bool ConvertPlaza(const std::string& directory, const PlazaOptions& options,
                   Dataset* dataset, PlazaSummary* summary, std::string* error) {
   *dataset = Dataset();
   *summary = PlazaSummary();
-  if (!CheckOptions(options, error)) return false;
+  if (!CheckPlazaOptions(options, error)) return false;
   const std::string prefix = directory + "/" + options.name;
   PlazaRaw raw;
   if (!ReadGroundTruth(prefix + "_GT.txt", &raw, error)) return false;

@@ -121,6 +121,10 @@ struct PlazaSummary {
   double measured_heading_offset = 0.0;
 };
 
+// Whether `options` are valid ("--flag=value: why" in `error`); ConvertPlaza
+// checks them first, and tools may check them before any work.
+bool CheckPlazaOptions(const PlazaOptions& options, std::string* error);
+
 // Reads DIRECTORY/NAME_{GT,DR,TD,TL}.txt and fills `dataset` (metadata,
 // priors, ODOM, RANGE, GT_POSE, GT_LANDMARK). Returns false with
 // "path:line: problem" on malformed input or a missing file.

@@ -84,16 +84,16 @@ std::unique_ptr<Kernel> CreateKernel(const KernelOptions& options,
                                      const std::string& flag_prefix) {
   for (const KernelEntry& entry : Registry()) {
     if (options.name != entry.name) continue;
+    // The period too, for every kernel: a value given is checked, used or
+    // not.
     if (!CheckPositive(flag_prefix + "kernel_variance", options.variance,
                        kMaxVariance, error) ||
         !CheckPositive(flag_prefix + "lengthscale", options.lengthscale,
-                       kMaxTimeScale, error)) {
+                       kMaxTimeScale, error) ||
+        !CheckPositive("period", options.period, kMaxTimeScale, error)) {
       return nullptr;
     }
     if (options.name == "periodic") {
-      if (!CheckPositive("period", options.period, kMaxTimeScale, error)) {
-        return nullptr;
-      }
       // Below this the series needs more than ~12000 terms (white noise).
       constexpr double kMinPeriodicLengthscale = 1e-3;
       if (options.lengthscale < kMinPeriodicLengthscale) {
