@@ -12,9 +12,12 @@
 namespace rff {
 namespace {
 
-// Every time the dataset mentions: the states reach both ends.
+// Every time the data constrain: the states reach both ends. Ground truth
+// only asks for outputs, which beyond the states extrapolate at constant
+// velocity (the WNOA posterior mean there).
 void TimeSpan(const Dataset& dataset, double* begin, double* end) {
-  std::vector<double> times = OutputTimes(dataset);
+  std::vector<double> times;
+  for (const Observation& o : dataset.observations) times.push_back(o.t);
   for (const Odometry& o : dataset.odometry) {
     times.push_back(o.t0);
     times.push_back(o.t1);
