@@ -126,6 +126,11 @@ bool CheckData(const Dataset& dataset, const SlamOptions& options,
       return false;
     }
   }
+  // The prior's size limits over the data's times, before any solve: its
+  // mean comes later, but the model's size does not depend on it.
+  if (!CreateTrajectoryModel(dataset, options, UnitWindowMean(), error)) {
+    return false;
+  }
   if (options.output.covariance) {
     std::set<LandmarkId> ids;
     for (const LandmarkPrior& p : dataset.landmark_priors) ids.insert(p.id);
