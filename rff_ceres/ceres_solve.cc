@@ -52,18 +52,6 @@ bool ToCeresOptions(const SolverOptions& options,
                          kPreconditioners);
     return false;
   }
-  // Only the iterative solvers precondition: a choice given for another
-  // would be silently ignored.
-  const bool iterative =
-      ceres_options->linear_solver_type == ceres::CGNR ||
-      ceres_options->linear_solver_type == ceres::ITERATIVE_SCHUR;
-  if (options.preconditioner != "auto" && !iterative) {
-    *error = OptionError("preconditioner", options.preconditioner,
-                         "--linear_solver=" + options.linear_solver +
-                             " is direct and uses none",
-                         "auto, or --linear_solver=ITERATIVE_SCHUR or CGNR");
-    return false;
-  }
   // Ceres 2.1's CGNR aborts on any other preconditioner.
   if (ceres_options->linear_solver_type == ceres::CGNR &&
       ceres_options->preconditioner_type != ceres::IDENTITY &&

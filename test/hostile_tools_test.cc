@@ -226,13 +226,6 @@ const HostileCase kHostileCases[] = {
      "rff_convert: error: --prior_sigma_xy=nan: not a finite number; "
      "allowed more than 0\n",
      "{dir}/o.rffd"},
-    // A preconditioner only an iterative solver would use.
-    {"PreconditionerWithADirectSolver",
-     SLAM "--linear_solver=DENSE_SCHUR --preconditioner=JACOBI" OUT,
-     "rff_slam: error: --preconditioner=JACOBI: --linear_solver=DENSE_SCHUR "
-     "is direct and uses none; allowed auto, or "
-     "--linear_solver=ITERATIVE_SCHUR or CGNR\n",
-     "{dir}/out.tum"},
     // Options of a mode not in use are checked all the same.
     {"ConvertInactiveFormatOption",
      "{bin}/rff_convert --to=g2o --input={dir}/valid.rffd --output={dir}/o.g2o "
