@@ -168,9 +168,10 @@ DEFINE_string(linear_solver, "auto",
               "ITERATIVE_SCHUR, DENSE_QR, DENSE_NORMAL_CHOLESKY, "
               "SPARSE_NORMAL_CHOLESKY or CGNR.");
 DEFINE_string(preconditioner, "auto",
-              "Ceres preconditioner of ITERATIVE_SCHUR and CGNR: IDENTITY, "
-              "JACOBI, SCHUR_JACOBI, CLUSTER_JACOBI, CLUSTER_TRIDIAGONAL; "
-              "auto picks SCHUR_JACOBI, or JACOBI for CGNR.");
+              "Ceres preconditioner of ITERATIVE_SCHUR and CGNR (the direct "
+              "solvers use none and leave it unused): IDENTITY, JACOBI, "
+              "SCHUR_JACOBI, CLUSTER_JACOBI, CLUSTER_TRIDIAGONAL; auto picks "
+              "SCHUR_JACOBI, or JACOBI for CGNR.");
 DEFINE_string(trust_region_strategy, "LEVENBERG_MARQUARDT",
               "LEVENBERG_MARQUARDT or DOGLEG.");
 DEFINE_int32(num_threads, 1,

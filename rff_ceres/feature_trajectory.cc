@@ -237,12 +237,16 @@ std::unique_ptr<FeatureTrajectory> FeatureTrajectory::Build(
         layout.covered / std::floor(kMaxPriorNonZeros / widest_segment_weights);
     if (requested.num_position_features == kAutoCapacity &&
         requested.segment_length == 0.0) {
-      // Automatic segments follow the lengthscale: that is the cause.
+      // Automatic segments follow the lengthscale: that is the cause. Their
+      // count, and with it the weights, falls as 1 / lengthscale.
+      const double lengthscale = requested.position_kernel.lengthscale;
       *error = OptionError(
-          "lengthscale", FormatNumber(requested.position_kernel.lengthscale),
+          "lengthscale", FormatNumber(lengthscale),
           why + " (automatic segments of " +
               FormatNumber(kSegmentLengthscales) + " lengthscales)",
-          "a longer lengthscale, or --segment_length of at least " +
+          "at least about " +
+              FormatNumber(lengthscale * prior_non_zeros / kMaxPriorNonZeros) +
+              ", or --segment_length of at least " +
               FormatNumber(shortest_segment) + layout.scope);
     } else if (requested.num_position_features == kAutoCapacity) {
       *error = OptionError(

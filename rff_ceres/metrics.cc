@@ -47,7 +47,7 @@ void WriteJsonSummary(const std::string& key, const ErrorSummary& summary,
 std::string Cell(double value) {
   char buffer[32];
   std::snprintf(buffer, sizeof(buffer),
-                std::abs(value) < 1e6 ? " %12.6f" : " %12.6g", value);
+                std::abs(value) < 1e5 ? " %12.6f" : " %12.6g", value);
   return buffer;
 }
 

@@ -4,8 +4,8 @@
 # docs/experiments/, with the per-run progress in docs/experiments/progress.log:
 #   scripts/experiments.sh [BUILD_DIR] [extra rff_experiment flags]
 # e.g. scripts/experiments.sh build --methods=rff,wnoa --num_threads=2
-# Methods whose configs are missing (configs/<family>_wnoa.flags before the
-# WNOA prior lands) give failed rows, not a failed script.
+# Methods whose configs are missing give failed rows, and the script then
+# exits 1 after writing every table (rff_experiment's exit status).
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 build=${1:-$root/build}

@@ -174,7 +174,7 @@ const HostileCase kHostileCases[] = {
      "rff_slam: error: {dir}/valid.rffd: --lengthscale=1e-06: the run's 10 s "
      "need 1e+06 segments of 24 features (x, y) and 26 (theta): more "
      "weights than memory allows (automatic segments of 10 lengthscales); "
-     "allowed a longer lengthscale, or --segment_length of at least "
+     "allowed at least about 9.14e-06, or --segment_length of at least "
      "9.140015903627673e-05 for this run\n",
      "{dir}/out.tum"},
     {"SegmentsOverTheRun",
@@ -252,8 +252,9 @@ const HostileCase kHostileCases[] = {
      "{dir}/out.tum"},
     // Flagfiles.
     {"EnvironmentFlagfile", SLAM "--fromenv=flagfile" OUT,
-     "rff_slam: error: --fromenv=flagfile: a flagfile from the environment is "
-     "not checked; allowed --flagfile=PATH instead\n",
+     "rff_slam: error: --fromenv=flagfile: a flagfile read from the "
+     "environment (directly or through another --fromenv) is not checked; "
+     "allowed --flagfile=PATH instead\n",
      "{dir}/out.tum"},
     {"SlamSelfIncludingFlagfile", SLAM "--flagfile={dir}/self.flags" OUT,
      "rff_slam: error: --flagfile={dir}/self.flags: includes itself",

@@ -45,15 +45,16 @@ std::string Trim(const std::string& text) {
 }
 
 // gflags's --fromenv and --tryfromenv read the flags they name from
-// FLAGS_<name> environment variables; a flagfile read that way would pass
-// every check here unseen.
+// FLAGS_<name> environment variables; a flagfile read that way, or another
+// --fromenv naming one, would pass every check here unseen.
 bool CheckFromEnvironment(const std::string& name, const std::string& value,
                           std::string* error) {
   if (name != "fromenv" && name != "tryfromenv") return true;
   for (const std::string& flag : SplitCommas(value)) {
-    if (flag == "flagfile") {
+    if (flag == "flagfile" || flag == "fromenv" || flag == "tryfromenv") {
       *error = OptionError(name, value,
-                           "a flagfile from the environment is not checked",
+                           "a flagfile read from the environment (directly or "
+                           "through another --fromenv) is not checked",
                            "--flagfile=PATH instead");
       return false;
     }

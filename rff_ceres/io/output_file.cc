@@ -183,16 +183,7 @@ bool OutputFile::Open(std::string* error) {
     *error = path_ + ": cannot open for writing: " + std::strerror(errno);
     return false;
   }
-  // mkstemp creates the file 0600; give it the mode of the file it replaces,
-  // or the one a new file would get.
-  struct stat old_file;
-  if (stat(path_.c_str(), &old_file) == 0 && S_ISREG(old_file.st_mode)) {
-    fchmod(fd, old_file.st_mode & 07777);
-  } else {
-    const mode_t mask = umask(0);
-    umask(mask);
-    fchmod(fd, 0666 & ~mask);
-  }
+  // mkstemp's 0600 while it is written; Commit gives it its final mode.
   close(fd);
   temporary_ = name;
   stream_.open(temporary_, std::ios::out | std::ios::trunc);
@@ -237,6 +228,18 @@ bool OutputFile::Close(std::string* error) {
 
 bool OutputFile::Commit(std::string* error) {
   if (!Close(error)) return false;
+  // The mode of the file it replaces (a read-only one too: only the
+  // directory must be writable), or the one a new file would get.
+  struct stat old_file;
+  mode_t mode;
+  if (stat(path_.c_str(), &old_file) == 0 && S_ISREG(old_file.st_mode)) {
+    mode = old_file.st_mode & 0777;
+  } else {
+    const mode_t mask = umask(0);
+    umask(mask);
+    mode = 0666 & ~mask;
+  }
+  chmod(temporary_.c_str(), mode);
   if (std::rename(temporary_.c_str(), path_.c_str()) != 0) {
     *error = path_ + ": cannot replace the file: " + std::strerror(errno);
     Discard();

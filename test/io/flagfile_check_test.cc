@@ -58,12 +58,16 @@ TEST(FlagfileCheckTest, SelfInclusionIsAnError) {
 // gflags would read FLAGS_flagfile from the environment unchecked.
 TEST(FlagfileCheckTest, AFlagfileFromTheEnvironmentIsAnError) {
   const std::string why =
-      ": a flagfile from the environment is not checked; allowed "
-      "--flagfile=PATH instead";
+      ": a flagfile read from the environment (directly or through another "
+      "--fromenv) is not checked; allowed --flagfile=PATH instead";
   EXPECT_EQ(Check({"--fromenv=flagfile"}), "--fromenv=flagfile" + why);
   EXPECT_EQ(Check({"--tryfromenv", "prior,flagfile"}),
             "--tryfromenv=prior,flagfile" + why);
   EXPECT_EQ(Check({"--fromenv=prior"}), "ok");
+  // FLAGS_fromenv=flagfile would be read through a second --fromenv.
+  EXPECT_EQ(Check({"--fromenv=fromenv"}), "--fromenv=fromenv" + why);
+  EXPECT_EQ(Check({"--fromenv=prior,tryfromenv"}),
+            "--fromenv=prior,tryfromenv" + why);
   const std::string dir = TempDir("FlagfileCheckTest");
   WriteFile(dir + "/env.flags", "--prior=rff\n--tryfromenv=flagfile\n");
   EXPECT_EQ(Check({"--flagfile=" + dir + "/env.flags"}),

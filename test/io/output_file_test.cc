@@ -215,6 +215,17 @@ TEST(OutputFileTest, CommitKeepsTheModeOfTheFileItReplaces) {
   ASSERT_EQ(stat((dir + "/private.txt").c_str(), &written), 0);
   EXPECT_EQ(written.st_mode & 07777, 0600u);
   EXPECT_EQ(ReadFile(dir + "/private.txt"), "new\n");
+  // A read-only file is replaced all the same (the directory is writable)
+  // and stays read-only; setuid bits are not carried over.
+  WriteFile(dir + "/readonly.txt", "old\n");
+  ASSERT_EQ(chmod((dir + "/readonly.txt").c_str(), 04444), 0);
+  ASSERT_TRUE(WriteOutputFile(
+      dir + "/readonly.txt", [](std::ostream* out) { *out << "new\n"; },
+      &error))
+      << error;
+  ASSERT_EQ(stat((dir + "/readonly.txt").c_str(), &written), 0);
+  EXPECT_EQ(written.st_mode & 07777, 0444u);
+  EXPECT_EQ(ReadFile(dir + "/readonly.txt"), "new\n");
 }
 
 }  // namespace
