@@ -351,35 +351,37 @@ TEST(MetricsTest, JsonHasNumbersAndNullsWithReasons) {
   EXPECT_EQ(text.substr(text.size() - 2), "}\n");
 }
 
-TEST(MetricsTest, TableShowsEveryMetric) {
+// The text table of three estimated poses shifted by `dx` in x.
+std::string TableOfShift(double dx) {
   std::vector<TimedPose> estimate = ThreePoses();
-  for (TimedPose& p : estimate) p.x += 0.5;
+  for (TimedPose& p : estimate) p.x += dx;
   Evaluation e;
   std::string error;
-  ASSERT_TRUE(Evaluate(ThreePoses(), {}, estimate, nullptr, {}, &e, &error));
+  EXPECT_TRUE(Evaluate(ThreePoses(), {}, estimate, nullptr, {}, &e, &error))
+      << error;
   std::ostringstream table;
   PrintEvaluation(e, &table);
-  EXPECT_THAT(table.str(),
+  return table.str();
+}
+
+TEST(MetricsTest, TableShowsEveryMetric) {
+  const std::string table = TableOfShift(0.5);
+  EXPECT_THAT(table,
               HasSubstr("APE translation [m]      0.500000     0.500000     "
                         "0.500000     0.500000       3\n"));
-  EXPECT_THAT(table.str(), HasSubstr("RPE rotation [deg]"));
-  EXPECT_THAT(table.str(),
-              HasSubstr("landmarks [m]         n/a (no estimated landmarks "
-                        "given)\n"));
+  EXPECT_THAT(table, HasSubstr("RPE rotation [deg]"));
+  EXPECT_THAT(table, HasSubstr("landmarks [m]         n/a (no estimated "
+                               "landmarks given)\n"));
 }
 
 // Errors too large for a fixed-point cell keep the table's columns.
 TEST(MetricsTest, TableShowsHugeErrorsInExponentForm) {
-  std::vector<TimedPose> estimate = ThreePoses();
-  for (TimedPose& p : estimate) p.x += 1e200;
-  Evaluation e;
-  std::string error;
-  ASSERT_TRUE(Evaluate(ThreePoses(), {}, estimate, nullptr, {}, &e, &error));
-  std::ostringstream table;
-  PrintEvaluation(e, &table);
-  EXPECT_THAT(table.str(),
+  EXPECT_THAT(TableOfShift(1e200),
               HasSubstr("APE translation [m]        1e+200       1e+200       "
                         "1e+200       1e+200       3\n"));
+  EXPECT_THAT(TableOfShift(123456.5),
+              HasSubstr("APE translation [m]        123456       123456       "
+                        "123456       123456       3\n"));
 }
 
 }  // namespace
