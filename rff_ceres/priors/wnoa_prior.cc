@@ -44,10 +44,10 @@ class WnoaPriorImpl : public TrajectoryPrior {
       const std::string& mean_name, std::shared_ptr<const MeanFunction> mean,
       std::string* error) const override {
     // A state at every distinct observation time, and at both ends of the
-    // data (ground truth beyond them extrapolates). A constant mean leaves the motion to the
-    // states: one at each end of every odometry residual too, or the cubic
-    // between states could not follow it (a 64 s stretch without observations
-    // would be one cubic).
+    // data (ground truth beyond them extrapolates). A constant mean leaves
+    // the motion to the states: one at each end of every odometry residual
+    // too, or the cubic between states could not follow it (a 64 s stretch
+    // without observations would be one cubic).
     double t_begin, t_end;
     TimeSpan(dataset, &t_begin, &t_end);
     std::vector<double> times = {t_begin, t_end};
