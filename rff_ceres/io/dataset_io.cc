@@ -30,6 +30,39 @@ const std::map<std::string_view, std::size_t>& RecordArity() {
   return *arity;
 }
 
+// Why a positive measurement sigma is finer than double precision resolves
+// its value (m or rad, at least 1), where its weight only overflows the
+// normal equations; empty when it is not.
+std::string UnresolvedSigma(double sigma, double value, const char* what,
+                            const char* quantity) {
+  const double resolution =
+      std::numeric_limits<double>::epsilon() * std::max(std::abs(value), 1.0);
+  if (sigma >= resolution) return "";
+  return std::string(what) + " " + FormatNumber(sigma) +
+         " is finer than double precision resolves its " + quantity +
+         "; allowed at least " + FormatNumber(resolution);
+}
+
+// The first observation the reader would refuse for its sigma, as
+// "RECORD at t = T: why"; empty when there is none.
+std::string FirstUnresolvedSigma(const Dataset& dataset) {
+  for (const Observation& o : dataset.observations) {
+    std::string why;
+    if (o.HasRange()) {
+      why = UnresolvedSigma(o.sigma_range, o.range, "sigma_range", "range");
+    }
+    if (why.empty() && o.HasBearing()) {
+      why = UnresolvedSigma(o.sigma_bearing, o.bearing, "sigma_bearing",
+                            "bearing");
+    }
+    if (!why.empty()) {
+      return std::string(MeasurementTypeOf(o.type).record) + " at t = " +
+             FormatNumber(o.t) + ": " + why;
+    }
+  }
+  return "";
+}
+
 // Parses one .rffd record at a time into a Dataset, with every check of the
 // format: field counts, finite numbers, positive sigmas, t1 > t0, ids.
 class DatasetParser {
@@ -110,20 +143,12 @@ class DatasetParser {
     return true;
   }
 
-  // A measurement's sigma is positive and no finer than double precision
-  // resolves its value (m or rad, at least 1): below that its weight only
-  // overflows the normal equations.
+  // A measurement's sigma is positive and resolved (UnresolvedSigma).
   bool Resolvable(double sigma, double value, const char* what,
                   const char* quantity) {
     if (!Positive(sigma, what)) return false;
-    const double resolution =
-        std::numeric_limits<double>::epsilon() * std::max(std::abs(value), 1.0);
-    if (sigma < resolution) {
-      return Fail(std::string(what) + " " + FormatNumber(sigma) +
-                  " is finer than double precision resolves its " + quantity +
-                  "; allowed at least " + FormatNumber(resolution));
-    }
-    return true;
+    const std::string why = UnresolvedSigma(sigma, value, what, quantity);
+    return why.empty() || Fail(why);
   }
 
   bool ParseHeader(const std::vector<std::string_view>& fields) {
@@ -368,6 +393,13 @@ void WriteDataset(const Dataset& dataset, std::ostream* output) {
 
 bool WriteDataset(const Dataset& dataset, const std::string& path,
                   std::string* error) {
+  // Never a file the reader refuses (a simulator's sigma given too fine).
+  const std::string unresolved = FirstUnresolvedSigma(dataset);
+  if (!unresolved.empty()) {
+    *error = path + ": not written: " + unresolved +
+             " (the reader would refuse the file)";
+    return false;
+  }
   return WriteOutputFile(
       path, [&](std::ostream* out) { WriteDataset(dataset, out); }, error);
 }

@@ -1,10 +1,12 @@
 #include "rff_ceres/io/dataset_io.h"
 
 #include <cmath>
+#include <filesystem>
 #include <sstream>
 
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
+#include "test/test_files.h"
 
 namespace rff {
 namespace {
@@ -191,6 +193,27 @@ TEST(DatasetIoTest, NegativeNoisyRangeIsData) {
   ASSERT_TRUE(Parse(std::string(kHead) + "RANGE 1 42 -0.25 1\n", &d, &error))
       << error;
   EXPECT_EQ(d.observations[0].range, -0.25);
+}
+
+// The writer never leaves a file its reader refuses: a sigma finer than
+// double precision resolves (a simulator's flag set too fine) is an error,
+// and nothing is written.
+TEST(DatasetIoTest, WriterRefusesWhatTheReaderWould) {
+  Dataset d;
+  std::string error;
+  ASSERT_TRUE(Parse(kValid, &d, &error)) << error;
+  for (Observation& o : d.observations) {
+    if (o.type == ObservationType::kRangeBearing) o.sigma_range = 1e-300;
+  }
+  const std::string path = testing::TempDir("DatasetIoTest") + "/fine.rffd";
+  EXPECT_FALSE(WriteDataset(d, path, &error));
+  EXPECT_EQ(error, path +
+                       ": not written: RANGE_BEARING at t = 1.5: "
+                       "sigma_range 1e-300 is finer than double precision "
+                       "resolves its range; allowed at least "
+                       "6.661338147750939e-16 (the reader would refuse the "
+                       "file)");
+  EXPECT_FALSE(std::filesystem::exists(path));
 }
 
 TEST(DatasetIoTest, MissingFileNamesThePath) {
