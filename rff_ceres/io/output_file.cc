@@ -111,6 +111,18 @@ bool CheckDirectory(const NamedPath& output, std::string* error) {
   }
   close(fd);
   std::remove(trial.c_str());
+  // In a sticky directory (/tmp) only a file's owner, the directory's or
+  // root may rename over it.
+  struct stat file, dir;
+  if (stat(output.path.c_str(), &file) == 0 &&
+      stat(directory.c_str(), &dir) == 0 && (dir.st_mode & S_ISVTX) != 0 &&
+      geteuid() != 0 && file.st_uid != geteuid() && dir.st_uid != geteuid()) {
+    *error = PathError(output,
+                       "another user's file in a sticky directory, which "
+                       "cannot be replaced",
+                       "a path of your own");
+    return false;
+  }
   return true;
 }
 

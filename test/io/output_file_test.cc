@@ -201,6 +201,34 @@ TEST(CheckOutputPathsTest, RefusesWhatIsNotARegularFile) {
   EXPECT_TRUE(std::filesystem::is_fifo(dir + "/pipe"));
 }
 
+// Another user's file in a sticky directory cannot be renamed over: refused
+// before any work. Run as root, the check runs in a child as user 65534.
+TEST(CheckOutputPathsTest, RefusesAnotherUsersFileInAStickyDirectory) {
+  if (geteuid() != 0) GTEST_SKIP() << "needs root to make another user's file";
+  const std::string dir = TempDir("CheckOutputPathsTest") + "/sticky";
+  ASSERT_TRUE(std::filesystem::create_directory(dir));
+  ASSERT_EQ(chmod(dir.c_str(), 01777), 0);
+  WriteFile(dir + "/root.txt", "root's\n");
+  const pid_t child = fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    std::string error;
+    const bool refused =
+        setgid(65534) == 0 && setuid(65534) == 0 &&
+        !CheckOutputPaths({}, {{"--o", dir + "/root.txt"}}, &error) &&
+        error == "--o=" + dir +
+                     "/root.txt: another user's file in a sticky directory, "
+                     "which cannot be replaced; allowed a path of your own" &&
+        CheckOutputPaths({}, {{"--o", dir + "/mine.txt"}}, &error);
+    _exit(refused ? 0 : 1);
+  }
+  int status = 0;
+  ASSERT_EQ(waitpid(child, &status, 0), child);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 0);
+  EXPECT_EQ(ReadFile(dir + "/root.txt"), "root's\n");
+}
+
 // A replaced file keeps its permissions.
 TEST(OutputFileTest, CommitKeepsTheModeOfTheFileItReplaces) {
   const std::string dir = TempDir("OutputFileTest");
