@@ -246,7 +246,9 @@ const AppCase kAppCases[] = {
      "{dir}/o.rffd"},
     {"ConvertMrclamWithoutRobot",
      "{bin}/rff_convert --format=mrclam --input={dir} --output={dir}/o.rffd",
-     "rff_convert: error: --mrclam_robot=0: allowed 1 to 5\n", "{dir}/o.rffd"},
+     "rff_convert: error: --mrclam_robot=0: no robot given (the default); "
+     "allowed 1 to 5\n",
+     "{dir}/o.rffd"},
     {"ConvertNegativeGtRate",
      "{bin}/rff_convert --format=mrclam --mrclam_robot=1 --input={dir} "
      "--output={dir}/o.rffd --gt_rate_hz=-1",

@@ -262,7 +262,8 @@ std::string ConverterDescription(const MrclamOptions& o) {
 
 bool CheckMrclamOptions(const MrclamOptions& o, std::string* error) {
   if (o.robot < 1 || o.robot > kLastRobotSubject) {
-    *error = OptionError("mrclam_robot", std::to_string(o.robot), "",
+    *error = OptionError("mrclam_robot", std::to_string(o.robot),
+                         o.robot == 0 ? "no robot given (the default)" : "",
                          "1 to " + std::to_string(kLastRobotSubject));
     return false;
   }
