@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <initializer_list>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -29,19 +30,34 @@ inline std::string OptionError(const std::string& flag,
 }
 
 // `value` must be finite and > 0 (>= 0); otherwise `error` names the flag.
+// Positive and normal: the floor of every "more than 0" option.
+inline bool IsNormalPositive(double value) {
+  return value >= std::numeric_limits<double>::min() && std::isfinite(value);
+}
+
+// Why a finite value is refused: a denormal (below double precision's
+// normal range, 2.2e-308) loses its digits, and its inverse overflows.
+inline std::string WhyNotOption(double value) {
+  if (!std::isfinite(value)) return "not a finite number";
+  if (value != 0.0 && std::abs(value) < std::numeric_limits<double>::min()) {
+    return "a denormal number, below double precision's normal range";
+  }
+  return "";
+}
 inline bool CheckPositiveOption(double value, const char* flag,
                                 std::string* error) {
-  if (value > 0.0 && std::isfinite(value)) return true;
-  *error = OptionError(flag, FormatNumber(value),
-                       std::isfinite(value) ? "" : "not a finite number",
+  if (IsNormalPositive(value)) return true;
+  *error = OptionError(flag, FormatNumber(value), WhyNotOption(value),
                        "more than 0");
   return false;
 }
 inline bool CheckNonNegativeOption(double value, const char* flag,
                                    std::string* error) {
-  if (value >= 0.0 && std::isfinite(value)) return true;
-  *error = OptionError(flag, FormatNumber(value),
-                       std::isfinite(value) ? "" : "not a finite number",
+  if ((value == 0.0 || value >= std::numeric_limits<double>::min()) &&
+      std::isfinite(value)) {
+    return true;
+  }
+  *error = OptionError(flag, FormatNumber(value), WhyNotOption(value),
                        "0 or more");
   return false;
 }

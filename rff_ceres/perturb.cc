@@ -91,7 +91,7 @@ bool ValidatePerturbOptions(const PerturbOptions& o, std::string* error) {
                  "start_heading_offset_deg", heading, "-360 to 360 degrees",
                  error) &&
          (!o.start_heading_sigma ||
-          InRange(*o.start_heading_sigma > 0.0 &&
+          InRange(IsNormalPositive(*o.start_heading_sigma) &&
                       *o.start_heading_sigma <= kMaxPerturbMagnitude,
                   "start_heading_sigma", *o.start_heading_sigma,
                   "more than 0 up to " + largest + " rad", error));

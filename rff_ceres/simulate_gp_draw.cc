@@ -76,9 +76,9 @@ bool ValidateGpDrawOptions(const SimulationOptions& options,
       {"gp_heading_kernel_variance", options.gp_heading_kernel_variance},
   };
   for (const auto& option : positives) {
-    if (!(std::isfinite(option.value) && option.value > 0.0 &&
-          option.value <= kMaxGpScale)) {
-      *error = OptionError(option.name, FormatNumber(option.value), "",
+    if (!(IsNormalPositive(option.value) && option.value <= kMaxGpScale)) {
+      *error = OptionError(option.name, FormatNumber(option.value),
+                           WhyNotOption(option.value),
                            "more than 0 up to " + FormatNumber(kMaxGpScale));
       return false;
     }

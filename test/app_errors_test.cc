@@ -104,7 +104,7 @@ const AppCase kAppCases[] = {
      "rff_slam: error: --lengthscale=0: allowed more than 0 up to 1e+12\n",
      "{dir}/out.tum"},
     {"SlamNaNLengthscale", SLAM "--lengthscale=nan" SLAM_OUT,
-     "rff_slam: error: --lengthscale=nan: allowed more than 0 up to 1e+12\n",
+     "rff_slam: error: --lengthscale=nan: not a finite number; allowed more than 0 up to 1e+12\n",
      "{dir}/out.tum"},
     {"SlamNegativeVariance", SLAM "--kernel_variance=-1" SLAM_OUT,
      "rff_slam: error: --kernel_variance=-1: allowed more than 0 up to "
@@ -286,8 +286,8 @@ const AppCase kAppCases[] = {
      "{dir}/s.rffd"},
     {"SimulateNaNRangeSigma",
      "{bin}/rff_simulate --output={dir}/s.rffd --sigma_range=nan",
-     "rff_simulate: error: --sigma_range=nan: allowed more than 0 up to "
-     "1e+06\n",
+     "rff_simulate: error: --sigma_range=nan: not a finite number; allowed "
+     "more than 0 up to 1e+06\n",
      "{dir}/s.rffd"},
     {"SimulateNaNBearingSigma",
      "{bin}/rff_simulate --output={dir}/s.rffd --sigma_bearing_deg=nan",

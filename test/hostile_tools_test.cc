@@ -44,7 +44,7 @@ void WriteInputs(const std::string& dir) {
   WriteFile(dir + "/tiny_odometry_sigma.rffd", tiny);
   WriteFile(dir + "/overflowing_odometry.rffd",
             "RFFD 1\nPRIOR_POSE 0 0 0 0 1 1\n"
-            "ODOM 0 1 1e308 0 0 1 1 1\nODOM 1 2 1e308 0 0 1 1 1\n"
+            "ODOM 0 1 1e308 0 0 1e300 1 1\nODOM 1 2 1e308 0 0 1e300 1 1\n"
             "GT_POSE 2 0 0 0\n");
   WriteFile(dir + "/far_truth.rffd",
             "RFFD 1\nPRIOR_POSE 0 0 0 0 1 1\nGT_POSE 0 -1e308 0 0\n");
@@ -202,7 +202,7 @@ const HostileCase kHostileCases[] = {
      "weights leave double range; allowed more than 0 up to 1e+12\n",
      "{dir}/out.tum"},
     {"WnoaLengthscaleNaN", SLAM "--prior=wnoa --lengthscale=nan" OUT,
-     "rff_slam: error: --lengthscale=nan: allowed more than 0 up to 1e+12\n",
+     "rff_slam: error: --lengthscale=nan: not a finite number; allowed more than 0 up to 1e+12\n",
      "{dir}/out.tum"},
     {"PreintegrationNaN", SLAM "--max_preintegration_seconds=nan" OUT,
      "rff_slam: error: --max_preintegration_seconds=nan: not a finite "
@@ -226,6 +226,11 @@ const HostileCase kHostileCases[] = {
      "rff_convert: error: --prior_sigma_xy=nan: not a finite number; "
      "allowed more than 0\n",
      "{dir}/o.rffd"},
+    // A denormal "positive" value has no digits, and its inverse overflows.
+    {"DenormalDiffusion", SLAM "--prior=wnoa --wnoa_position_qc=0x1p-1074" OUT,
+     "rff_slam: error: --wnoa_position_qc=5e-324: a denormal number, below "
+     "double precision's normal range; allowed more than 0\n",
+     "{dir}/out.tum"},
     // Options of a mode not in use are checked all the same.
     {"ConvertInactiveFormatOption",
      "{bin}/rff_convert --to=g2o --input={dir}/valid.rffd --output={dir}/o.g2o "
@@ -272,8 +277,8 @@ const HostileCase kHostileCases[] = {
     // Numbers that overflow and messages that name the cause.
     {"TinyOdometrySigma",
      "{bin}/rff_slam --dataset={dir}/tiny_odometry_sigma.rffd" OUT,
-     "odometry from t = 0 to 1: its covariance cannot be inverted in double "
-     "precision (sigmas too small)",
+     "tiny_odometry_sigma.rffd:10: sigma_x 1e-100 is finer than double "
+     "precision resolves its dx; allowed at least 2.220446049250313e-16\n",
      "{dir}/out.tum"},
     {"DeadReckoningOverflow",
      "{bin}/rff_dead_reckoning --dataset={dir}/overflowing_odometry.rffd "

@@ -43,9 +43,59 @@ std::string UnresolvedSigma(double sigma, double value, const char* what,
          "; allowed at least " + FormatNumber(resolution);
 }
 
-// The first observation the reader would refuse for its sigma, as
+// The same for an ODOM interval, whose length its times must resolve.
+std::string UnresolvedInterval(double t0, double t1) {
+  const double resolution = std::numeric_limits<double>::epsilon() *
+                            std::max({std::abs(t0), std::abs(t1), 1.0});
+  if (t1 - t0 >= resolution) return "";
+  return "t1 - t0 = " + FormatNumber(t1 - t0) +
+         " s is finer than double precision resolves its times; allowed at "
+         "least " +
+         FormatNumber(resolution);
+}
+
+// Why a pose prior, a landmark prior or an odometry record is refused for
+// a sigma (or an interval) finer than double precision resolves; empty when
+// it is not.
+std::string UnresolvedPosePrior(const PosePrior& p) {
+  std::string why = UnresolvedSigma(
+      p.sigma_xy, std::max(std::abs(p.pose.x), std::abs(p.pose.y)),
+      "sigma_xy", "position");
+  if (why.empty()) {
+    why = UnresolvedSigma(p.sigma_theta, p.pose.theta, "sigma_theta",
+                          "heading");
+  }
+  return why;
+}
+std::string UnresolvedLandmarkPrior(const LandmarkPrior& p) {
+  return UnresolvedSigma(p.sigma, std::max(std::abs(p.x), std::abs(p.y)),
+                         "sigma", "position");
+}
+std::string UnresolvedOdometry(const Odometry& o) {
+  std::string why = UnresolvedInterval(o.t0, o.t1);
+  if (why.empty()) why = UnresolvedSigma(o.sigma_x, o.dx, "sigma_x", "dx");
+  if (why.empty()) why = UnresolvedSigma(o.sigma_y, o.dy, "sigma_y", "dy");
+  if (why.empty()) {
+    why = UnresolvedSigma(o.sigma_theta, o.dtheta, "sigma_theta", "dtheta");
+  }
+  return why;
+}
+
+// The first record the reader would refuse for its sigmas, as
 // "RECORD at t = T: why"; empty when there is none.
 std::string FirstUnresolvedSigma(const Dataset& dataset) {
+  for (const PosePrior& p : dataset.pose_priors) {
+    const std::string why = UnresolvedPosePrior(p);
+    if (!why.empty()) return "PRIOR_POSE at t = " + FormatNumber(p.pose.t) + ": " + why;
+  }
+  for (const LandmarkPrior& p : dataset.landmark_priors) {
+    const std::string why = UnresolvedLandmarkPrior(p);
+    if (!why.empty()) return "PRIOR_LANDMARK " + std::to_string(p.id) + ": " + why;
+  }
+  for (const Odometry& o : dataset.odometry) {
+    const std::string why = UnresolvedOdometry(o);
+    if (!why.empty()) return "ODOM at t = " + FormatNumber(o.t0) + ": " + why;
+  }
   for (const Observation& o : dataset.observations) {
     std::string why;
     if (o.HasRange()) {
@@ -165,8 +215,10 @@ class DatasetParser {
     if (!Positive(v[4], "sigma_xy") || !Positive(v[5], "sigma_theta")) {
       return false;
     }
-    dataset_->pose_priors.push_back(
-        {{v[0], v[1], v[2], WrapAngle(v[3])}, v[4], v[5]});
+    const PosePrior prior{{v[0], v[1], v[2], WrapAngle(v[3])}, v[4], v[5]};
+    const std::string why = UnresolvedPosePrior(prior);
+    if (!why.empty()) return Fail(why);
+    dataset_->pose_priors.push_back(prior);
     return true;
   }
 
@@ -176,7 +228,10 @@ class DatasetParser {
       return Fail("duplicate PRIOR_LANDMARK for landmark " +
                   std::to_string(id));
     }
-    dataset_->landmark_priors.push_back({id, v[0], v[1], v[2]});
+    const LandmarkPrior prior{id, v[0], v[1], v[2]};
+    const std::string why = UnresolvedLandmarkPrior(prior);
+    if (!why.empty()) return Fail(why);
+    dataset_->landmark_priors.push_back(prior);
     return true;
   }
 
@@ -201,8 +256,11 @@ class DatasetParser {
         !Positive(v[7], "sigma_theta")) {
       return false;
     }
-    dataset_->odometry.push_back(
-        {v[0], v[1], v[2], v[3], WrapAngle(v[4]), v[5], v[6], v[7]});
+    const Odometry odometry{v[0], v[1], v[2],           v[3],
+                            WrapAngle(v[4]), v[5], v[6], v[7]};
+    const std::string why = UnresolvedOdometry(odometry);
+    if (!why.empty()) return Fail(why);
+    dataset_->odometry.push_back(odometry);
     return true;
   }
 

@@ -51,12 +51,12 @@ constexpr double kMaxVariance = 1e24;
 
 bool CheckPositive(const std::string& flag, double value, double largest,
                    std::string* error) {
-  if (value > 0.0 && value <= largest) return true;
+  if (IsNormalPositive(value) && value <= largest) return true;
   *error = OptionError(
       flag, FormatNumber(value),
       value > largest ? "the features' frequencies and weights leave double "
                         "range"
-                      : "",
+                      : WhyNotOption(value),
       "more than 0 up to " + FormatNumber(largest));
   return false;
 }

@@ -128,6 +128,15 @@ const BadCase kBadCases[] = {
     {"BearingSigmaBelowDoubleResolution", "RFFD 1\nBEARING 1 2 0.1 1e-300\n",
      ":2: sigma_bearing 1e-300 is finer than double precision resolves its "
      "bearing; allowed at least 2.220446049250313e-16"},
+    {"PosePriorSigmaDenormal", "RFFD 1\nPRIOR_POSE 0 0 0 0 1e-320 1\n",
+     ":2: sigma_xy 1e-320 is finer than double precision "
+     "resolves its position; allowed at least 2.220446049250313e-16"},
+    {"LandmarkPriorSigmaTiny", "RFFD 1\nPRIOR_LANDMARK 3 100 0 1e-20\n",
+     ":2: sigma 1e-20 is finer than double precision resolves its position; "
+     "allowed at least 2.220446049250313e-14"},
+    {"OdometryIntervalTooShort", "RFFD 1\nODOM 0 1e-150 0 0 0 1 1 1\n",
+     ":2: t1 - t0 = 1e-150 s is finer than double precision resolves its "
+     "times; allowed at least 2.220446049250313e-16"},
     {"SpanBeyondDoubleRange",
      "RFFD 1\nPRIOR_POSE -1e308 0 0 0 1 1\nRANGE 1e308 2 3 1\n",
      "test.rffd: the records' times run from -1e+308 to 1e+308 s, a span "
