@@ -128,11 +128,11 @@ DEFINE_double(spline_smoothing, 0.98,
 DEFINE_string(loss, "auto",
               "Robust loss on observations: none, huber, cauchy, auto (cauchy, "
               "then none where no residual is an outlier).");
-DEFINE_double(loss_scale, 2.0, "Robust loss scale, in sigmas (more than 0).");
+DEFINE_double(loss_scale, 2.0, "Robust loss scale, in sigmas (0.001 to 1000).");
 DEFINE_string(odometry_loss, "auto",
               "Robust loss on odometry residuals: none, huber, cauchy, auto.");
 DEFINE_double(odometry_loss_scale, 2.0,
-              "Robust odometry loss scale, in sigmas (more than 0).");
+              "Robust odometry loss scale, in sigmas (0.001 to 1000).");
 DEFINE_bool(estimate_range_calibration, false,
             "Estimate a range sensor model scale * distance + offset jointly "
             "(one per run) for the ranges of RANGE and RANGE_BEARING records, "

@@ -42,8 +42,17 @@ bool CreateLoss(const LossOptions& options, const std::string& flag,
                 std::unique_ptr<ceres::LossFunction>* loss,
                 std::string* error) {
   loss->reset();
-  // Checked with "none" too: a value given is checked, used or not.
+  // Checked with "none" too: a value given is checked, used or not. Scales
+  // are in sigmas: beyond these bounds every residual, or none, is an
+  // outlier, and the smallest overflow the loss's 1 / scale^2.
+  constexpr double kMinLossScale = 1e-3, kMaxLossScale = 1e3;
   if (!CheckPositiveOption(options.scale, (flag + "_scale").c_str(), error)) {
+    return false;
+  }
+  if (options.scale < kMinLossScale || options.scale > kMaxLossScale) {
+    *error = OptionError(flag + "_scale", FormatNumber(options.scale), "",
+                         FormatNumber(kMinLossScale) + " to " +
+                             FormatNumber(kMaxLossScale) + " sigmas");
     return false;
   }
   if (options.name == "none") return true;

@@ -231,6 +231,11 @@ const HostileCase kHostileCases[] = {
      "rff_slam: error: --wnoa_position_qc=5e-324: a denormal number, below "
      "double precision's normal range; allowed more than 0\n",
      "{dir}/out.tum"},
+    // A loss scale so small that every residual is an outlier, and its
+    // 1 / scale^2 overflows.
+    {"LossScaleTiny", SLAM "--loss=cauchy --loss_scale=1e-150" OUT,
+     "rff_slam: error: --loss_scale=1e-150: allowed 0.001 to 1000 sigmas\n",
+     "{dir}/out.tum"},
     // Options of a mode not in use are checked all the same.
     {"ConvertInactiveFormatOption",
      "{bin}/rff_convert --to=g2o --input={dir}/valid.rffd --output={dir}/o.g2o "
