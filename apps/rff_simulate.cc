@@ -99,6 +99,21 @@ int Fail(const std::string& message) {
   return 1;
 }
 
+// An angle flag in degrees, checked in the unit given (the library's bounds
+// are in radians): more than 0 in radians too, up to 360.
+bool CheckDegrees(const char* flag, double degrees, std::string* error) {
+  if (rff::IsNormalPositive(degrees * M_PI / 180.0) && degrees <= 360.0) {
+    return true;
+  }
+  *error = rff::OptionError(
+      flag, rff::FormatNumber(degrees),
+      std::isfinite(degrees) && degrees > 0.0 && degrees <= 360.0
+          ? "too small for radians in double precision"
+          : rff::WhyNotOption(degrees),
+      "more than 0 up to 360");
+  return false;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -142,13 +157,8 @@ int main(int argc, char** argv) {
   }
   if (all || Given("sigma_range")) options.sigma_range = FLAGS_sigma_range;
   if (all || Given("sigma_bearing_deg")) {
-    // Checked in the unit given: the library's bound is in radians.
-    constexpr double kMaxSigmaBearingDeg = 360.0;
-    if (!(FLAGS_sigma_bearing_deg > 0.0 &&
-          FLAGS_sigma_bearing_deg <= kMaxSigmaBearingDeg)) {
-      return Fail(rff::OptionError(
-          "sigma_bearing_deg", rff::FormatNumber(FLAGS_sigma_bearing_deg), "",
-          "more than 0 up to " + rff::FormatNumber(kMaxSigmaBearingDeg)));
+    if (!CheckDegrees("sigma_bearing_deg", FLAGS_sigma_bearing_deg, &error)) {
+      return Fail(error);
     }
     options.sigma_bearing = FLAGS_sigma_bearing_deg * kDegree;
   }
@@ -171,10 +181,8 @@ int main(int argc, char** argv) {
   if (all || Given("sensor_range")) options.sensor_range = FLAGS_sensor_range;
   if (all || Given("min_range")) options.min_range = FLAGS_min_range;
   if (all || Given("field_of_view_deg")) {
-    if (!(FLAGS_field_of_view_deg > 0.0 && FLAGS_field_of_view_deg <= 360.0)) {
-      return Fail(rff::OptionError("field_of_view_deg",
-                                   rff::FormatNumber(FLAGS_field_of_view_deg),
-                                   "", "more than 0 up to 360"));
+    if (!CheckDegrees("field_of_view_deg", FLAGS_field_of_view_deg, &error)) {
+      return Fail(error);
     }
     // 360 degrees must map to exactly 2 pi, the "all around" value.
     options.field_of_view = FLAGS_field_of_view_deg == 360.0

@@ -291,8 +291,13 @@ const AppCase kAppCases[] = {
      "{dir}/s.rffd"},
     {"SimulateNaNBearingSigma",
      "{bin}/rff_simulate --output={dir}/s.rffd --sigma_bearing_deg=nan",
-     "rff_simulate: error: --sigma_bearing_deg=nan: allowed more than 0 up "
-     "to 360\n",
+     "rff_simulate: error: --sigma_bearing_deg=nan: not a finite number; "
+     "allowed more than 0 up to 360\n",
+     "{dir}/s.rffd"},
+    {"SimulateFieldOfViewBelowRadians",
+     "{bin}/rff_simulate --output={dir}/s.rffd --field_of_view_deg=0x1p-1074",
+     "rff_simulate: error: --field_of_view_deg=5e-324: too small for radians "
+     "in double precision; allowed more than 0 up to 360\n",
      "{dir}/s.rffd"},
     {"SimulateZeroFieldOfView",
      "{bin}/rff_simulate --output={dir}/s.rffd --field_of_view_deg=0",
