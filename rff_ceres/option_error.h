@@ -51,14 +51,25 @@ inline bool CheckPositiveOption(double value, const char* flag,
                        "more than 0");
   return false;
 }
+// More than 0 (normal) and at most `largest`; `too_large` says why a larger
+// value is refused, where the allowed range alone does not.
+inline bool CheckPositiveUpToOption(double value, const std::string& flag,
+                                    double largest, std::string* error,
+                                    const std::string& too_large = "") {
+  if (IsNormalPositive(value) && value <= largest) return true;
+  *error = OptionError(flag, FormatNumber(value),
+                       value > largest ? too_large : WhyNotOption(value),
+                       "more than 0 up to " + FormatNumber(largest));
+  return false;
+}
 inline bool CheckNonNegativeOption(double value, const char* flag,
                                    std::string* error) {
   if ((value == 0.0 || value >= std::numeric_limits<double>::min()) &&
       std::isfinite(value)) {
     return true;
   }
-  *error = OptionError(flag, FormatNumber(value), WhyNotOption(value),
-                       "0 or more");
+  *error =
+      OptionError(flag, FormatNumber(value), WhyNotOption(value), "0 or more");
   return false;
 }
 

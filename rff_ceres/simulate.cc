@@ -175,8 +175,7 @@ class OptionChecker {
  private:
   void Range(const char* name, double value, bool allow_zero) {
     if (!ok_) return;
-    const bool low_ok =
-        IsNormalPositive(value) || (allow_zero && value == 0.0);
+    const bool low_ok = IsNormalPositive(value) || (allow_zero && value == 0.0);
     if (!(std::isfinite(value) && low_ok && value <= kMaxMagnitude)) {
       Fail(OptionError(name, FormatNumber(value), WhyNotOption(value),
                        (allow_zero ? "0 to " : "more than 0 up to ") +

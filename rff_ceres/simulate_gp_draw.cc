@@ -76,10 +76,8 @@ bool ValidateGpDrawOptions(const SimulationOptions& options,
       {"gp_heading_kernel_variance", options.gp_heading_kernel_variance},
   };
   for (const auto& option : positives) {
-    if (!(IsNormalPositive(option.value) && option.value <= kMaxGpScale)) {
-      *error = OptionError(option.name, FormatNumber(option.value),
-                           WhyNotOption(option.value),
-                           "more than 0 up to " + FormatNumber(kMaxGpScale));
+    if (!CheckPositiveUpToOption(option.value, option.name, kMaxGpScale,
+                                 error)) {
       return false;
     }
   }

@@ -104,7 +104,8 @@ const AppCase kAppCases[] = {
      "rff_slam: error: --lengthscale=0: allowed more than 0 up to 1e+12\n",
      "{dir}/out.tum"},
     {"SlamNaNLengthscale", SLAM "--lengthscale=nan" SLAM_OUT,
-     "rff_slam: error: --lengthscale=nan: not a finite number; allowed more than 0 up to 1e+12\n",
+     "rff_slam: error: --lengthscale=nan: not a finite number; allowed more "
+     "than 0 up to 1e+12\n",
      "{dir}/out.tum"},
     {"SlamNegativeVariance", SLAM "--kernel_variance=-1" SLAM_OUT,
      "rff_slam: error: --kernel_variance=-1: allowed more than 0 up to "

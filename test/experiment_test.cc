@@ -537,8 +537,7 @@ TEST(RffExperimentAppTest, BadFlagsExitWithAMessage) {
                         "mine=configs/{family}_mine.flags)\n"));
   // A solver option out of range stops the tool before the grid starts.
   const std::string bad_option = binary + " --out_dir=" + dir +
-                                 " --num_features=30000 2> " + dir +
-                                 "/err.txt";
+                                 " --num_features=30000 2> " + dir + "/err.txt";
   EXPECT_NE(std::system(bad_option.c_str()), 0);
   EXPECT_THAT(testing::ReadFile(dir + "/err.txt"),
               HasSubstr("rff_experiment: error: --num_features=30000: "));

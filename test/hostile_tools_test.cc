@@ -202,7 +202,8 @@ const HostileCase kHostileCases[] = {
      "weights leave double range; allowed more than 0 up to 1e+12\n",
      "{dir}/out.tum"},
     {"WnoaLengthscaleNaN", SLAM "--prior=wnoa --lengthscale=nan" OUT,
-     "rff_slam: error: --lengthscale=nan: not a finite number; allowed more than 0 up to 1e+12\n",
+     "rff_slam: error: --lengthscale=nan: not a finite number; allowed more "
+     "than 0 up to 1e+12\n",
      "{dir}/out.tum"},
     {"PreintegrationNaN", SLAM "--max_preintegration_seconds=nan" OUT,
      "rff_slam: error: --max_preintegration_seconds=nan: not a finite "
@@ -258,8 +259,7 @@ const HostileCase kHostileCases[] = {
      "rff_slam: error: --odometry_loss_scale=-1: allowed more than 0\n",
      "{dir}/out.tum"},
     {"PeriodOfAnotherKernel", SLAM "--kernel=rbf --period=nan" OUT,
-     "rff_slam: error: --period=nan: ",
-     "{dir}/out.tum"},
+     "rff_slam: error: --period=nan: ", "{dir}/out.tum"},
     // Flagfiles.
     {"EnvironmentFlagfile", SLAM "--fromenv=flagfile" OUT,
      "rff_slam: error: --fromenv=flagfile: a flagfile read from the "

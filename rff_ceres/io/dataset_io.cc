@@ -2,8 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <set>
 #include <sstream>
@@ -54,16 +54,16 @@ std::string UnresolvedInterval(double t0, double t1) {
          FormatNumber(resolution);
 }
 
-// Why a pose prior, a landmark prior or an odometry record is refused for
-// a sigma (or an interval) finer than double precision resolves; empty when
-// it is not.
+// Why a pose prior, a landmark prior, an odometry record or an observation
+// is refused for a sigma (or an interval) finer than double precision
+// resolves; empty when it is not. The reader and the writer both ask.
 std::string UnresolvedPosePrior(const PosePrior& p) {
   std::string why = UnresolvedSigma(
-      p.sigma_xy, std::max(std::abs(p.pose.x), std::abs(p.pose.y)),
-      "sigma_xy", "position");
+      p.sigma_xy, std::max(std::abs(p.pose.x), std::abs(p.pose.y)), "sigma_xy",
+      "position");
   if (why.empty()) {
-    why = UnresolvedSigma(p.sigma_theta, p.pose.theta, "sigma_theta",
-                          "heading");
+    why =
+        UnresolvedSigma(p.sigma_theta, p.pose.theta, "sigma_theta", "heading");
   }
   return why;
 }
@@ -81,33 +81,40 @@ std::string UnresolvedOdometry(const Odometry& o) {
   return why;
 }
 
+std::string UnresolvedObservation(const Observation& o) {
+  std::string why;
+  if (o.HasRange()) {
+    why = UnresolvedSigma(o.sigma_range, o.range, "sigma_range", "range");
+  }
+  if (why.empty() && o.HasBearing()) {
+    why =
+        UnresolvedSigma(o.sigma_bearing, o.bearing, "sigma_bearing", "bearing");
+  }
+  return why;
+}
+
 // The first record the reader would refuse for its sigmas, as
 // "RECORD at t = T: why"; empty when there is none.
 std::string FirstUnresolvedSigma(const Dataset& dataset) {
   for (const PosePrior& p : dataset.pose_priors) {
     const std::string why = UnresolvedPosePrior(p);
-    if (!why.empty()) return "PRIOR_POSE at t = " + FormatNumber(p.pose.t) + ": " + why;
+    if (!why.empty())
+      return "PRIOR_POSE at t = " + FormatNumber(p.pose.t) + ": " + why;
   }
   for (const LandmarkPrior& p : dataset.landmark_priors) {
     const std::string why = UnresolvedLandmarkPrior(p);
-    if (!why.empty()) return "PRIOR_LANDMARK " + std::to_string(p.id) + ": " + why;
+    if (!why.empty())
+      return "PRIOR_LANDMARK " + std::to_string(p.id) + ": " + why;
   }
   for (const Odometry& o : dataset.odometry) {
     const std::string why = UnresolvedOdometry(o);
     if (!why.empty()) return "ODOM at t = " + FormatNumber(o.t0) + ": " + why;
   }
   for (const Observation& o : dataset.observations) {
-    std::string why;
-    if (o.HasRange()) {
-      why = UnresolvedSigma(o.sigma_range, o.range, "sigma_range", "range");
-    }
-    if (why.empty() && o.HasBearing()) {
-      why = UnresolvedSigma(o.sigma_bearing, o.bearing, "sigma_bearing",
-                            "bearing");
-    }
+    const std::string why = UnresolvedObservation(o);
     if (!why.empty()) {
-      return std::string(MeasurementTypeOf(o.type).record) + " at t = " +
-             FormatNumber(o.t) + ": " + why;
+      return std::string(MeasurementTypeOf(o.type).record) +
+             " at t = " + FormatNumber(o.t) + ": " + why;
     }
   }
   return "";
@@ -193,14 +200,6 @@ class DatasetParser {
     return true;
   }
 
-  // A measurement's sigma is positive and resolved (UnresolvedSigma).
-  bool Resolvable(double sigma, double value, const char* what,
-                  const char* quantity) {
-    if (!Positive(sigma, what)) return false;
-    const std::string why = UnresolvedSigma(sigma, value, what, quantity);
-    return why.empty() || Fail(why);
-  }
-
   bool ParseHeader(const std::vector<std::string_view>& fields) {
     if (seen_header_) return Fail("second RFFD header");
     if (fields[1] != "1") {
@@ -256,8 +255,8 @@ class DatasetParser {
         !Positive(v[7], "sigma_theta")) {
       return false;
     }
-    const Odometry odometry{v[0], v[1], v[2],           v[3],
-                            WrapAngle(v[4]), v[5], v[6], v[7]};
+    const Odometry odometry{v[0], v[1], v[2], v[3], WrapAngle(v[4]),
+                            v[5], v[6], v[7]};
     const std::string why = UnresolvedOdometry(odometry);
     if (!why.empty()) return Fail(why);
     dataset_->odometry.push_back(odometry);
@@ -284,14 +283,14 @@ class DatasetParser {
     }
     // A noisy range may be negative (a Gaussian measurement of a short
     // distance): it is data, not an error.
-    if (obs.HasRange() && !Resolvable(obs.sigma_range, obs.range,
-                                      "sigma_range", "range")) {
+    if (obs.HasRange() && !Positive(obs.sigma_range, "sigma_range")) {
       return false;
     }
-    if (obs.HasBearing() && !Resolvable(obs.sigma_bearing, obs.bearing,
-                                        "sigma_bearing", "bearing")) {
+    if (obs.HasBearing() && !Positive(obs.sigma_bearing, "sigma_bearing")) {
       return false;
     }
+    const std::string why = UnresolvedObservation(obs);
+    if (!why.empty()) return Fail(why);
     dataset_->observations.push_back(obs);
     return true;
   }

@@ -51,14 +51,9 @@ constexpr double kMaxVariance = 1e24;
 
 bool CheckPositive(const std::string& flag, double value, double largest,
                    std::string* error) {
-  if (IsNormalPositive(value) && value <= largest) return true;
-  *error = OptionError(
-      flag, FormatNumber(value),
-      value > largest ? "the features' frequencies and weights leave double "
-                        "range"
-                      : WhyNotOption(value),
-      "more than 0 up to " + FormatNumber(largest));
-  return false;
+  return CheckPositiveUpToOption(
+      value, flag, largest, error,
+      "the features' frequencies and weights leave double range");
 }
 
 }  // namespace

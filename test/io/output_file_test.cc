@@ -236,8 +236,7 @@ TEST(OutputFileTest, CommitKeepsTheModeOfTheFileItReplaces) {
   ASSERT_EQ(chmod((dir + "/private.txt").c_str(), 0600), 0);
   std::string error;
   ASSERT_TRUE(WriteOutputFile(
-      dir + "/private.txt", [](std::ostream* out) { *out << "new\n"; },
-      &error))
+      dir + "/private.txt", [](std::ostream* out) { *out << "new\n"; }, &error))
       << error;
   struct stat written;
   ASSERT_EQ(stat((dir + "/private.txt").c_str(), &written), 0);

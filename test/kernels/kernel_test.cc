@@ -70,7 +70,8 @@ TEST(KernelTest, RejectsBadOptions) {
             "--lengthscale=0: allowed more than 0 up to 1e+12");
   options.lengthscale = NAN;
   EXPECT_EQ(CreateError(options),
-            "--lengthscale=nan: not a finite number; allowed more than 0 up to 1e+12");
+            "--lengthscale=nan: not a finite number; allowed more than 0 up to "
+            "1e+12");
   options.lengthscale = 1.0;
   options.variance = -2.0;
   EXPECT_EQ(CreateError(options),

@@ -77,8 +77,9 @@ TEST(TrajectoryPriorTest, UnknownPriorIsAnOptionError) {
   SlamOptions options;
   options.prior = "brownian";
   std::string error;
-  EXPECT_EQ(CreateTrajectoryModel(TenSeconds(), options, UnitWindowMean(), &error),
-            nullptr);
+  EXPECT_EQ(
+      CreateTrajectoryModel(TenSeconds(), options, UnitWindowMean(), &error),
+      nullptr);
   EXPECT_EQ(error, "--prior=brownian: unknown prior; allowed rff or wnoa");
 }
 
