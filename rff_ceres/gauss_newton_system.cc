@@ -7,6 +7,34 @@
 namespace rff {
 namespace {
 
+// P^T L^-T D^-1 L^-1 P z of a SimplicialLDLT (H = P^T L D L^T P), all columns
+// of z in one pass over L: Eigen's own solve walks L once per column, which
+// for many right-hand sides is bound by reading L. Row-major, a row of the
+// right-hand sides is contiguous. Per column the operations and their order
+// are Eigen's (sparse_solve_triangular_selector), so the result is the same.
+Eigen::MatrixXd SolveLdltByRows(
+    const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>& ldlt,
+    const Eigen::MatrixXd& z) {
+  using RowMajorDense =
+      Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  RowMajorDense x = ldlt.permutationP() * z;
+  const Eigen::SparseMatrix<double>& l = ldlt.matrixL().nestedExpression();
+  const Eigen::Index n = l.cols();
+  for (Eigen::Index j = 0; j < n; ++j) {  // L x = b, unit diagonal.
+    for (Eigen::SparseMatrix<double>::InnerIterator it(l, j); it; ++it) {
+      if (it.index() > j) x.row(it.index()) -= it.value() * x.row(j);
+    }
+  }
+  const Eigen::VectorXd d_inverse = ldlt.vectorD().cwiseInverse();
+  for (Eigen::Index j = 0; j < n; ++j) x.row(j) *= d_inverse[j];
+  for (Eigen::Index j = n - 1; j >= 0; --j) {  // L^T x = b.
+    for (Eigen::SparseMatrix<double>::InnerIterator it(l, j); it; ++it) {
+      if (it.index() > j) x.row(j) -= it.value() * x.row(it.index());
+    }
+  }
+  return ldlt.permutationPinv() * Eigen::MatrixXd(x);
+}
+
 // 2^25 doubles (256 MB) for A and B together.
 constexpr double kMaxDenseEntries = 33554432.0;
 constexpr int kChunkRows = 256;
@@ -166,14 +194,17 @@ Eigen::VectorXd GaussNewtonSystem::ApplyCInverse(
   return out;
 }
 
-Eigen::VectorXd GaussNewtonSystem::Solve(const Eigen::VectorXd& z) const {
-  if (!structured_) return sparse_.solve(z);
+Eigen::MatrixXd GaussNewtonSystem::Solve(const Eigen::MatrixXd& z) const {
+  if (!structured_) return SolveLdltByRows(sparse_, z);
   const Eigen::Index t = b_.rows(), m = b_.cols();
-  const Eigen::VectorXd leading =
-      schur_.solve(z.head(t) - b_ * ApplyCInverse(z.tail(m)));
-  Eigen::VectorXd u(z.size());
-  u.head(t) = leading;
-  u.tail(m) = ApplyCInverse(z.tail(m) - b_.transpose() * leading);
+  Eigen::MatrixXd u(z.rows(), z.cols());
+  for (Eigen::Index k = 0; k < z.cols(); ++k) {
+    const Eigen::VectorXd leading =
+        schur_.solve(z.col(k).head(t) - b_ * ApplyCInverse(z.col(k).tail(m)));
+    u.col(k).head(t) = leading;
+    u.col(k).tail(m) =
+        ApplyCInverse(z.col(k).tail(m) - b_.transpose() * leading);
+  }
   return u;
 }
 

@@ -61,8 +61,9 @@ class GaussNewtonSystem {
   // Whether the Schur form was built (covariances are available).
   bool structured() const { return structured_; }
   bool positive_definite() const { return positive_definite_; }
-  // H^-1 z.
-  Eigen::VectorXd Solve(const Eigen::VectorXd& z) const;
+  // H^-1 z, every column of z at once: the sparse factor is read once for
+  // all of them, with the same arithmetic as one column at a time.
+  Eigen::MatrixXd Solve(const Eigen::MatrixXd& z) const;
   // Structured only: S^-1, the covariance of the leading t parameters.
   Eigen::MatrixXd LeadingCovariance() const;
   // Structured only: the 2x2 covariance of every landmark.

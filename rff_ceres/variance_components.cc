@@ -1,5 +1,6 @@
 #include "rff_ceres/variance_components.h"
 
+#include <algorithm>
 #include <random>
 #include <vector>
 
@@ -80,15 +81,25 @@ bool EstimateVarianceComponents(SlamProblem* problem,
 
   std::array<double, kNumVarianceGroups> traces{};
   std::mt19937 engine(options.seed);
-  Eigen::VectorXd z(jacobian.cols());
-  for (int probe = 0; probe < options.probes; ++probe) {
-    for (Eigen::Index i = 0; i < z.size(); ++i) {
-      z[i] = (engine() & 1u) ? 1.0 : -1.0;
+  // Probes in batches: one pass over J and the factor per batch, and
+  // J's rows times the batch in memory, not times every probe.
+  constexpr int kProbesPerPass = 8;
+  using RowMajorDense =
+      Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  for (int first = 0; first < options.probes; first += kProbesPerPass) {
+    const int count = std::min(kProbesPerPass, options.probes - first);
+    Eigen::MatrixXd z(jacobian.cols(), count);
+    for (int probe = 0; probe < count; ++probe) {
+      for (Eigen::Index i = 0; i < z.rows(); ++i) {
+        z(i, probe) = (engine() & 1u) ? 1.0 : -1.0;
+      }
     }
-    const Eigen::VectorXd jz = jacobian * z;
-    const Eigen::VectorXd ju = jacobian * hessian.Solve(z);
-    for (Eigen::Index r = 0; r < jz.size(); ++r) {
-      traces[static_cast<int>(groups[r])] += jz[r] * ju[r];
+    const RowMajorDense jz = jacobian * RowMajorDense(z);
+    const RowMajorDense ju = jacobian * RowMajorDense(hessian.Solve(z));
+    for (int probe = 0; probe < count; ++probe) {
+      for (Eigen::Index r = 0; r < jz.rows(); ++r) {
+        traces[static_cast<int>(groups[r])] += jz(r, probe) * ju(r, probe);
+      }
     }
   }
   for (Eigen::Index r = 0; r < residuals.size(); ++r) {

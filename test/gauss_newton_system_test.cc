@@ -51,6 +51,33 @@ TEST(GaussNewtonSystemTest, EveryFactorizationSolvesTheSameSystem) {
   EXPECT_LT((sparse.Solve(z) - expected).cwiseAbs().maxCoeff(), 1e-9 * scale);
 }
 
+// All columns at once give, bit for bit, what Eigen's own solve gives one
+// column at a time (the same operations in the same order).
+TEST(GaussNewtonSystemTest, ManyColumnsSolveAsEigenSolvesEach) {
+  const int t = 60;
+  const RowMajorSparse jacobian = ChainWithLandmarks(t, 4, 11);
+  const GaussNewtonSystem sparse(jacobian, t, Factorization::kSparse);
+  const GaussNewtonSystem schur(jacobian, t, Factorization::kSchurOnly);
+  ASSERT_TRUE(sparse.positive_definite());
+  ASSERT_TRUE(schur.positive_definite());
+  const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> eigen(
+      Eigen::SparseMatrix<double>(jacobian.transpose()) * jacobian);
+  std::mt19937 rng(5);
+  std::normal_distribution<double> normal;
+  Eigen::MatrixXd z(jacobian.cols(), 7);
+  for (Eigen::Index i = 0; i < z.size(); ++i) z.data()[i] = normal(rng);
+  const Eigen::MatrixXd many = sparse.Solve(z);
+  const Eigen::MatrixXd many_schur = schur.Solve(z);
+  for (Eigen::Index k = 0; k < z.cols(); ++k) {
+    const Eigen::VectorXd one = eigen.solve(z.col(k).eval());
+    for (Eigen::Index i = 0; i < z.rows(); ++i) {
+      ASSERT_EQ(many(i, k), one[i]) << "row " << i << ", column " << k;
+    }
+    EXPECT_LT((many_schur.col(k) - one).cwiseAbs().maxCoeff(),
+              1e-9 * one.cwiseAbs().maxCoeff());
+  }
+}
+
 TEST(GaussNewtonSystemTest, SchurOnlyLeavesASystemWithoutTheFormUnfactorised) {
   // A row on two landmarks: not the Schur form.
   const int t = 10;
