@@ -11,7 +11,8 @@ namespace {
 // of z in one pass over L: Eigen's own solve walks L once per column, which
 // for many right-hand sides is bound by reading L. Row-major, a row of the
 // right-hand sides is contiguous. Per column the operations and their order
-// are Eigen's (sparse_solve_triangular_selector), so the result is the same.
+// are Eigen's (sparse_solve_triangular_selector), so the values are the
+// same; only a zero's sign may differ (Eigen skips subtracting a zero).
 Eigen::MatrixXd SolveLdltByRows(
     const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>& ldlt,
     const Eigen::MatrixXd& z) {

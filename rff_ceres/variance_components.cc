@@ -81,13 +81,15 @@ bool EstimateVarianceComponents(SlamProblem* problem,
 
   std::array<double, kNumVarianceGroups> traces{};
   std::mt19937 engine(options.seed);
-  // Probes in batches: one pass over J and the factor per batch, and
-  // J's rows times the batch in memory, not times every probe.
-  constexpr int kProbesPerPass = 8;
+  // Probes in batches: one pass over J and the factor per batch. A batch
+  // holds J's rows times its probes twice: at most 2^22 doubles each.
+  constexpr Eigen::Index kMaxBatchEntries = Eigen::Index{1} << 22;
+  const int per_pass = static_cast<int>(std::clamp<Eigen::Index>(
+      kMaxBatchEntries / std::max<Eigen::Index>(jacobian.rows(), 1), 1, 8));
   using RowMajorDense =
       Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
-  for (int first = 0; first < options.probes; first += kProbesPerPass) {
-    const int count = std::min(kProbesPerPass, options.probes - first);
+  for (int first = 0; first < options.probes; first += per_pass) {
+    const int count = std::min(per_pass, options.probes - first);
     Eigen::MatrixXd z(jacobian.cols(), count);
     for (int probe = 0; probe < count; ++probe) {
       for (Eigen::Index i = 0; i < z.rows(); ++i) {

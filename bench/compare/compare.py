@@ -104,14 +104,15 @@ def main():
             fixed_s, _, _ = solve(args.build, dataset,
                                   [d, "--learn_hyperparameters=off"],
                                   args.repeats, summary)
+            apes = " / ".join("-" if a is None else f"{a:.4f}" for a in
+                              (peer["ape_trans_m"], same_ape, default_ape))
             print(f"| {os.path.basename(dataset)} | {peer_s:.3f} "
                   f"| {same_s:.3f} | {peer_s / same_s:.2f} "
                   f"| {default_s:.3f} | {peer_s / default_s:.2f} "
                   f"| {fixed_s:.3f} | {peer_s / fixed_s:.2f} "
                   f"| {peer['iterations']} / {same['iterations']} "
                   f"| {peer['final_cost']:.3f} / {same['final_cost']:.3f} "
-                  f"| {peer['ape_trans_m']:.4f} / {same_ape:.4f} / "
-                  f"{default_ape:.4f} |")
+                  f"| {apes} |")
 
 
 if __name__ == "__main__":

@@ -4,18 +4,24 @@
 The peer that rff_slam's speed is compared against (bench/compare/README.md):
 the MAP of one global feature map per coordinate,
 
-    x_k(t) = m_k(t) + phi(t)^T b_k,  b_k ~ N(0, I),  k = x, y, theta,
+    x_k(t) = m_k(t) + delta g_k(t) + phi(t)^T b_k,  b_k ~ N(0, I),
 
 with phi the Hilbert basis of an RBF kernel (Solin and Saerkkae 2020, eq. 56:
 phi_j(t) = sqrt(S(w_j) / L) sin(w_j (t - c + L)), w_j = pi j / (2 L)), m the
-dead reckoning from the first pose prior (the constant first pose when there
-is no odometry), and range, bearing, odometry, pose-prior and landmark-prior
-residuals whitened by their sigmas. Levenberg-Marquardt on the dense normal
-equations, stopped like Ceres at a relative cost change of 1e-8.
+dead reckoning from the earliest pose prior, delta g(t) its rotation about
+that pose to first order (rff_ceres/mean_rotation.h), and range-bearing,
+odometry, pose-prior and landmark-prior residuals whitened by their sigmas.
+A range-bearing record closer than two range sigmas is its landmark's offset
+along and across the measured ray (costs/near_landmark_cost.h). That is the
+model rff_slam solves with compare.SAME_MODEL_FLAGS. Levenberg-Marquardt on
+the dense normal equations, stopped like Ceres at a relative cost change of
+1e-8.
 
 Usage: numpy_dense_lm.py DATASET.rffd [--num_features=100] [--lengthscale=5]
        [--kernel_variance=100] [--heading_kernel_variance=0.25]
-Prints one JSON line: solve seconds, iterations, final cost, APE.
+Prints one JSON line: solve seconds, iterations, final cost, APE. A file
+outside the model (no odometry, RANGE or BEARING records, gaps that rff_slam
+would split the run at) is refused with a message and exit status 1.
 """
 import argparse
 import json
@@ -24,28 +30,49 @@ import time
 
 import numpy as np
 
+FIELDS = {"PRIOR_POSE": 6, "PRIOR_LANDMARK": 4, "ODOM": 8, "RANGE_BEARING": 6,
+          "GT_POSE": 4, "GT_LANDMARK": 3, "RANGE": 4, "BEARING": 4}
+NEAR_RANGE_SIGMAS = 2.0  # costs/near_landmark_cost.h, kNearRangeSigmas.
+LOOSE_HEADING_SIGMA = 0.5  # rff_ceres/initialization.h, kLooseHeadingSigma.
+MAX_GAP_LENGTHSCALES = 10.0  # rff_slam splits a run at longer gaps.
+
+
+def fail(message):
+    sys.exit(f"numpy_dense_lm.py: {message}")
+
 
 def read_rffd(path):
-    """The records the model uses, as float arrays, in file order."""
+    """The records as float arrays, each kind sorted by its first field."""
     records = {}
-    with open(path, encoding="utf-8") as f:
-        for line in f:
-            fields = line.split("#", 1)[0].split()
-            if not fields or fields[0] == "RFFD":
-                continue
-            records.setdefault(fields[0], []).append([float(v) for v in fields[1:]])
-    for kind in ("RANGE", "BEARING"):
-        if kind in records:
-            sys.exit(f"{path}: {kind} records are outside this peer's model")
-    if any(k not in records
-           for k in ("PRIOR_POSE", "PRIOR_LANDMARK", "RANGE_BEARING")):
-        sys.exit(f"{path}: needs PRIOR_POSE, PRIOR_LANDMARK and RANGE_BEARING "
-                 "records")
-    data = {k: np.array(v) for k, v in records.items()}
+    try:
+        with open(path, encoding="utf-8") as f:
+            lines = f.readlines()
+    except (OSError, UnicodeDecodeError) as e:
+        fail(f"{path}: cannot read: {e}")
+    for number, line in enumerate(lines, 1):
+        fields = line.split("#", 1)[0].split()
+        if not fields or fields[0] == "RFFD":
+            continue
+        kind = fields[0]
+        if kind in ("RANGE", "BEARING"):
+            fail(f"{path}:{number}: {kind} records are outside this peer's "
+                 "model")
+        if kind not in FIELDS or len(fields) != FIELDS[kind] + 1:
+            fail(f"{path}:{number}: not a record this peer reads: {line.strip()}")
+        try:
+            values = [float(v) for v in fields[1:]]
+        except ValueError:
+            fail(f"{path}:{number}: a field is not a number: {line.strip()}")
+        records.setdefault(kind, []).append(values)
+    for kind in ("PRIOR_POSE", "PRIOR_LANDMARK", "RANGE_BEARING", "ODOM"):
+        if kind not in records:
+            fail(f"{path}: needs {kind} records (the peer's mean is the dead "
+                 "reckoning, and every landmark needs a prior)")
+    data = {k: np.array(sorted(v)) for k, v in records.items()}
     unknown = set(data["RANGE_BEARING"][:, 1]) - set(data["PRIOR_LANDMARK"][:, 0])
     if unknown:
-        sys.exit(f"{path}: landmark {int(min(unknown))} is observed but has no "
-                 "PRIOR_LANDMARK, which this peer needs")
+        fail(f"{path}: landmark {int(min(unknown))} is observed but has no "
+             "PRIOR_LANDMARK")
     return data
 
 
@@ -53,23 +80,23 @@ def wrap(a):
     return (a + np.pi) % (2.0 * np.pi) - np.pi
 
 
-def dead_reckoning(prior, odom, times):
-    """The first pose prior composed with the ODOM records, at `times`."""
+def dead_reckoning(prior, odom):
+    """Knot times and poses of the ODOM chain from the pose prior `prior`."""
+    if odom[0, 0] != prior[0] or np.any(odom[1:, 0] != odom[:-1, 1]):
+        fail("the ODOM records must form one chain starting at the earliest "
+             "PRIOR_POSE")
     pose = prior[1:4].copy()
-    if odom is None:
-        return np.tile(pose, (len(times), 1))
     knots, poses = [prior[0]], [pose.copy()]
-    for t0, t1, dx, dy, dth, *_ in odom:
+    for _, t1, dx, dy, dth, *_ in odom:
         c, s = np.cos(pose[2]), np.sin(pose[2])
         pose = pose + np.array([c * dx - s * dy, s * dx + c * dy, dth])
         knots.append(t1)
         poses.append(pose.copy())
-    poses = np.array(poses)
-    return np.stack([np.interp(times, knots, poses[:, k]) for k in range(3)], 1)
+    return np.array(knots), np.array(poses)
 
 
-def hilbert_features(times, num_features, lengthscale, variance):
-    begin, end = times.min(), times.max()
+def hilbert_features(times, window, num_features, lengthscale, variance):
+    begin, end = window
     half = 0.5 * (end - begin)
     half_width = half + max(0.1 * half, 4.0 * lengthscale)
     w = np.pi * np.arange(1, num_features + 1) / (2.0 * half_width)
@@ -83,21 +110,25 @@ def hilbert_features(times, num_features, lengthscale, variance):
 
 class Model:
     def __init__(self, data, args):
-        rb = data["RANGE_BEARING"]
-        self.prior = data["PRIOR_POSE"][0]
-        odom = data.get("ODOM")
-        times = [rb[:, 0], self.prior[:1]]
-        if odom is not None:
-            times += [odom[:, 0], odom[:, 1]]
-        self.times = np.unique(np.concatenate(times))
-        self.mean = dead_reckoning(self.prior, odom, self.times)
-        n = args.num_features
-        phi_xy = hilbert_features(self.times, n, args.lengthscale,
-                                  args.kernel_variance)
-        phi_th = hilbert_features(self.times, n, args.lengthscale,
-                                  args.heading_kernel_variance)
-        self.phi = [phi_xy, phi_xy, phi_th]
-        self.n = n
+        rb, odom = data["RANGE_BEARING"], data["ODOM"]
+        self.priors = data["PRIOR_POSE"]
+        first = self.priors[np.argmin(self.priors[:, 0])]
+        self.times = np.unique(np.concatenate(
+            [rb[:, 0], self.priors[:, 0], odom[:, 0], odom[:, 1]]))
+        gaps = np.diff(self.times)
+        if gaps.size and gaps.max() > MAX_GAP_LENGTHSCALES * args.lengthscale:
+            fail(f"a gap of {gaps.max():g} s: rff_slam would split the run "
+                 "there, this peer has one global map")
+        queries = self.times
+        if "GT_POSE" in data:
+            queries = np.concatenate([queries, data["GT_POSE"][:, 0]])
+        self.window = (queries.min(), queries.max())
+        self.knots, self.knot_poses = dead_reckoning(first, odom)
+        self.anchor = self.mean_at(first[:1])[0]
+        self.delta_sigma = min(first[5], LOOSE_HEADING_SIGMA)
+        self.args = args
+        self.n = n = args.num_features
+        self.phi, self.mean, self.rotation = self.basis(self.times)
         lm = data["PRIOR_LANDMARK"]
         self.ids = {int(i): k for k, i in enumerate(lm[:, 0])}
         self.lm_prior, self.lm_sigma = lm[:, 1:3], lm[:, 3]
@@ -106,92 +137,142 @@ class Model:
         self.obs_lm = np.array([self.ids[int(i)] for i in rb[:, 1]])
         self.obs = rb[:, 2:4]
         self.obs_sigma = rb[:, 4:6]
+        self.near = self.obs[:, 0] < NEAR_RANGE_SIGMAS * self.obs_sigma[:, 0]
         self.odom = odom
-        if odom is not None:
-            self.odom_from, self.odom_to = index(odom[:, 0]), index(odom[:, 1])
-        self.prior_index = index(self.prior[:1])[0]
+        self.odom_from, self.odom_to = index(odom[:, 0]), index(odom[:, 1])
+        self.prior_index = index(self.priors[:, 0])
+        # Parameters: 3 n weights, the mean's turn delta, the landmarks.
         self.num_weights = 3 * n
-        self.num_params = 3 * n + 2 * len(self.ids)
+        self.delta = 3 * n
+        self.num_params = 3 * n + 1 + 2 * len(self.ids)
 
-    def poses(self, params):
+    def mean_at(self, times):
+        return np.stack([np.interp(times, self.knots, self.knot_poses[:, k])
+                         for k in range(3)], 1)
+
+    def basis(self, times):
+        """Features per coordinate, the mean and the turn's g(t) at `times`."""
+        a = self.args
+        phi_xy = hilbert_features(times, self.window, a.num_features,
+                                  a.lengthscale, a.kernel_variance)
+        phi_th = hilbert_features(times, self.window, a.num_features,
+                                  a.lengthscale, a.heading_kernel_variance)
+        mean = self.mean_at(times)
+        arm = mean[:, :2] - self.anchor[:2]
+        rotation = np.stack([-arm[:, 1], arm[:, 0], np.ones(len(times))], 1)
+        return [phi_xy, phi_xy, phi_th], mean, rotation
+
+    def poses(self, params, basis=None):
+        phi, mean, rotation = basis or (self.phi, self.mean, self.rotation)
         b = params[: self.num_weights].reshape(3, self.n)
-        return self.mean + np.stack([self.phi[k] @ b[k] for k in range(3)], 1)
+        return (mean + params[self.delta] * rotation +
+                np.stack([phi[k] @ b[k] for k in range(3)], 1))
 
-    def linearize(self, params):
-        """Whitened residuals and their dense Jacobian."""
-        n, nw = self.n, self.num_weights
-        poses = self.poses(params)
-        lms = params[nw:].reshape(-1, 2)
-        blocks_r, blocks_j = [], []
+    def pose_rows(self, d_pose, at):
+        """d r / d (b, delta) from d r / d pose at the model times `at`."""
+        n = self.n
+        j = np.zeros((d_pose.shape[0], self.num_params))
+        for k in range(3):
+            j[:, k * n:(k + 1) * n] = d_pose[:, k, None] * self.phi[k][at]
+        j[:, self.delta] = (d_pose * self.rotation[at]).sum(1)
+        return j
 
-        def pose_rows(d_pose, at):
-            # d r / d b_k = d r / d pose_k * phi_k(t): one dense row band.
-            j = np.zeros((d_pose.shape[0], self.num_params))
-            for k in range(3):
-                j[:, k * n:(k + 1) * n] += d_pose[:, k, None] * self.phi[k][at]
-            return j
-
-        # Range and bearing.
+    def observation_rows(self, poses, lms):
+        """Two rows per range-bearing record: residuals, d/dpose, d/dlandmark."""
         p, l = poses[self.obs_pose], lms[self.obs_lm]
+        s_r, s_b = self.obs_sigma[:, 0], self.obs_sigma[:, 1]
+        z_r, z_b = self.obs[:, 0], self.obs[:, 1]
         d = l - p[:, :2]
         r2 = (d ** 2).sum(1)
         r = np.sqrt(r2)
-        s_r, s_b = self.obs_sigma[:, 0], self.obs_sigma[:, 1]
-        res_r = (r - self.obs[:, 0]) / s_r
-        res_b = wrap(np.arctan2(d[:, 1], d[:, 0]) - p[:, 2] - self.obs[:, 1]) / s_b
-        dr_dl = d / r[:, None] / s_r[:, None]
-        db_dl = np.stack([-d[:, 1], d[:, 0]], 1) / r2[:, None] / s_b[:, None]
-        zeros = np.zeros_like(r)
-        j_r = pose_rows(np.stack([-dr_dl[:, 0], -dr_dl[:, 1], zeros], 1),
-                        self.obs_pose)
-        j_b = pose_rows(np.stack([-db_dl[:, 0], -db_dl[:, 1], -1 / s_b], 1),
-                        self.obs_pose)
-        cols = nw + 2 * self.obs_lm
-        rows = np.arange(len(r))
-        for c in range(2):
-            j_r[rows, cols + c] = dr_dl[:, c]
-            j_b[rows, cols + c] = db_dl[:, c]
-        blocks_r += [res_r, res_b]
-        blocks_j += [j_r, j_b]
+        res = np.stack([(r - z_r) / s_r,
+                        wrap(np.arctan2(d[:, 1], d[:, 0]) - p[:, 2] - z_b) / s_b])
+        d_lm = np.stack([d / (r * s_r)[:, None],
+                         np.stack([-d[:, 1], d[:, 0]], 1) / (r2 * s_b)[:, None]])
+        d_pose = np.concatenate(
+            [-d_lm, np.stack([np.zeros_like(r), -1 / s_b])[:, :, None]], 2)
+        # Near records: q = R(theta)^T (l - p) along and across the ray.
+        c, s = np.cos(p[:, 2]), np.sin(p[:, 2])
+        rt = np.stack([np.stack([c, s], 1), np.stack([-s, c], 1)], 1)
+        q = np.einsum("mij,mj->mi", rt, d)
+        across = np.hypot(z_r, s_r) * s_b
+        ray = np.stack([np.cos(z_b), np.sin(z_b)], 1)
+        whitening = np.stack([ray / s_r[:, None],
+                              np.stack([-ray[:, 1], ray[:, 0]], 1) /
+                              across[:, None]])
+        near_res = np.einsum("rmi,mi->rm", whitening, q)
+        near_res[0] -= z_r / s_r
+        near_lm = np.einsum("rmi,mij->rmj", whitening, rt)
+        dq_dth = np.stack([q[:, 1], -q[:, 0]], 1)
+        near_pose = np.concatenate(
+            [-near_lm, np.einsum("rmi,mi->rm", whitening, dq_dth)[:, :, None]],
+            2)
+        near = self.near[None, :]
+        return (np.where(near, near_res, res),
+                np.where(near[:, :, None], near_pose, d_pose),
+                np.where(near[:, :, None], near_lm, d_lm))
+
+    def linearize(self, params):
+        """Whitened residuals and their dense Jacobian."""
+        nw = self.num_weights
+        poses = self.poses(params)
+        lms = params[nw + 1:].reshape(-1, 2)
+        blocks_r, blocks_j = [], []
+
+        res, d_pose, d_lm = self.observation_rows(poses, lms)
+        cols = nw + 1 + 2 * self.obs_lm
+        rows = np.arange(len(cols))
+        for row in range(2):
+            j = self.pose_rows(d_pose[row], self.obs_pose)
+            for c in range(2):
+                j[rows, cols + c] = d_lm[row, :, c]
+            blocks_r.append(res[row])
+            blocks_j.append(j)
 
         # Odometry: the motion from t0 to t1 in the frame of the pose at t0.
-        if self.odom is not None:
-            a, b = poses[self.odom_from], poses[self.odom_to]
-            sig = self.odom[:, 5:8]
-            c, s = np.cos(a[:, 2]), np.sin(a[:, 2])
-            dx, dy = b[:, 0] - a[:, 0], b[:, 1] - a[:, 1]
-            pred = np.stack([c * dx + s * dy, -s * dx + c * dy,
-                             wrap(b[:, 2] - a[:, 2])], 1)
-            res = (pred - self.odom[:, 2:5])
-            res[:, 2] = wrap(res[:, 2])
-            res /= sig
-            for row in range(3):
-                d_b = np.zeros((len(c), 3))
-                if row == 0:
-                    d_b[:, 0], d_b[:, 1] = c, s
-                    d_th = -s * dx + c * dy
-                elif row == 1:
-                    d_b[:, 0], d_b[:, 1] = -s, c
-                    d_th = -c * dx - s * dy
-                else:
-                    d_b[:, 2] = 1.0
-                    d_th = -np.ones_like(c)
-                d_a = -d_b.copy()
-                d_a[:, 2] = d_th if row < 2 else -1.0
-                blocks_r.append(res[:, row])
-                blocks_j.append((pose_rows(d_a, self.odom_from) +
-                                 pose_rows(d_b, self.odom_to)) / sig[:, row, None])
+        a, b = poses[self.odom_from], poses[self.odom_to]
+        sig = self.odom[:, 5:8]
+        c, s = np.cos(a[:, 2]), np.sin(a[:, 2])
+        dx, dy = b[:, 0] - a[:, 0], b[:, 1] - a[:, 1]
+        pred = np.stack([c * dx + s * dy, -s * dx + c * dy, b[:, 2] - a[:, 2]], 1)
+        res = pred - self.odom[:, 2:5]
+        res[:, 2] = wrap(res[:, 2])
+        res /= sig
+        for row in range(3):
+            d_b = np.zeros((len(c), 3))
+            if row == 0:
+                d_b[:, 0], d_b[:, 1] = c, s
+                d_th = -s * dx + c * dy
+            elif row == 1:
+                d_b[:, 0], d_b[:, 1] = -s, c
+                d_th = -c * dx - s * dy
+            else:
+                d_b[:, 2] = 1.0
+                d_th = -np.ones_like(c)
+            d_a = -d_b
+            d_a[:, 2] = d_th
+            blocks_r.append(res[:, row])
+            blocks_j.append((self.pose_rows(d_a, self.odom_from) +
+                             self.pose_rows(d_b, self.odom_to)) /
+                            sig[:, row, None])
 
-        # First-pose prior, landmark priors, weight prior.
-        sig = np.array([self.prior[4], self.prior[4], self.prior[5]])
-        res = poses[self.prior_index] - self.prior[1:4]
-        res[2] = wrap(res[2])
-        blocks_r.append(res / sig)
-        blocks_j.append(pose_rows(np.diag(1 / sig),
-                                  np.full(3, self.prior_index)))
+        # Pose priors, the turn's prior, landmark priors, weight prior.
+        sig = self.priors[:, [4, 4, 5]]
+        res = poses[self.prior_index] - self.priors[:, 1:4]
+        res[:, 2] = wrap(res[:, 2])
+        res /= sig
+        for row in range(3):
+            d_pose = np.zeros((len(sig), 3))
+            d_pose[:, row] = 1.0 / sig[:, row]
+            blocks_r.append(res[:, row])
+            blocks_j.append(self.pose_rows(d_pose, self.prior_index))
+        j = np.zeros((1, self.num_params))
+        j[0, self.delta] = 1.0 / self.delta_sigma
+        blocks_r.append(params[self.delta:self.delta + 1] / self.delta_sigma)
+        blocks_j.append(j)
         res = ((lms - self.lm_prior) / self.lm_sigma[:, None]).ravel()
         j = np.zeros((res.size, self.num_params))
-        j[:, nw:] = np.diag(np.repeat(1 / self.lm_sigma, 2))
+        j[:, nw + 1:] = np.diag(np.repeat(1 / self.lm_sigma, 2))
         blocks_r += [res, params[:nw]]
         blocks_j += [j, np.eye(nw, self.num_params)]
         return np.concatenate(blocks_r), np.vstack(blocks_j)
@@ -230,20 +311,23 @@ def main():
     parser.add_argument("--kernel_variance", type=float, default=100.0)
     parser.add_argument("--heading_kernel_variance", type=float, default=0.25)
     args = parser.parse_args()
+    if args.num_features < 1 or not (args.lengthscale > 0 and
+                                     args.kernel_variance > 0 and
+                                     args.heading_kernel_variance > 0):
+        fail("--num_features must be 1 or more and the kernel's values more "
+             "than 0")
     data = read_rffd(args.dataset)
     start = time.perf_counter()
     model = Model(data, args)
     params = np.zeros(model.num_params)
-    params[model.num_weights:] = model.lm_prior.ravel()
+    params[model.num_weights + 1:] = model.lm_prior.ravel()
     params, cost, iterations = levenberg_marquardt(model, params)
     seconds = time.perf_counter() - start
     ape = None
     if "GT_POSE" in data:
         truth = data["GT_POSE"]
-        poses = model.poses(params)
-        est = np.stack([np.interp(truth[:, 0], model.times, poses[:, k])
-                        for k in range(2)], 1)
-        ape = float(np.sqrt(((est - truth[:, 1:3]) ** 2).sum(1).mean()))
+        poses = model.poses(params, model.basis(truth[:, 0]))
+        ape = float(np.sqrt(((poses[:, :2] - truth[:, 1:3]) ** 2).sum(1).mean()))
     print(json.dumps({"seconds": seconds, "iterations": iterations,
                       "final_cost": cost, "ape_trans_m": ape,
                       "num_parameters": model.num_params}))
