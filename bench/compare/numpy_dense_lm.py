@@ -41,34 +41,62 @@ def fail(message):
     sys.exit(f"numpy_dense_lm.py: {message}")
 
 
+SIGMAS = {"PRIOR_POSE": (4, 5), "PRIOR_LANDMARK": (3,), "ODOM": (5, 6, 7),
+          "RANGE_BEARING": (4, 5)}
+IDS = {"PRIOR_LANDMARK": 0, "RANGE_BEARING": 1, "GT_LANDMARK": 0}
+
+
 def read_rffd(path):
-    """The records as float arrays, each kind sorted by its first field."""
+    """The records as float arrays (observations and odometry in time order,
+    pose priors in file order); fails on anything rff_slam would refuse."""
     records = {}
     try:
         with open(path, encoding="utf-8") as f:
             lines = f.readlines()
     except (OSError, UnicodeDecodeError) as e:
         fail(f"{path}: cannot read: {e}")
+    header = False
     for number, line in enumerate(lines, 1):
         fields = line.split("#", 1)[0].split()
-        if not fields or fields[0] == "RFFD":
+        if not fields:
+            continue
+        where = f"{path}:{number}"
+        if not header:
+            if fields != ["RFFD", "1"]:
+                fail(f"{where}: the first record must be the header RFFD 1")
+            header = True
             continue
         kind = fields[0]
         if kind in ("RANGE", "BEARING"):
-            fail(f"{path}:{number}: {kind} records are outside this peer's "
-                 "model")
+            fail(f"{where}: {kind} records are outside this peer's model")
         if kind not in FIELDS or len(fields) != FIELDS[kind] + 1:
-            fail(f"{path}:{number}: not a record this peer reads: {line.strip()}")
+            fail(f"{where}: not a record this peer reads: {line.strip()}")
         try:
             values = [float(v) for v in fields[1:]]
         except ValueError:
-            fail(f"{path}:{number}: a field is not a number: {line.strip()}")
+            fail(f"{where}: a field is not a number: {line.strip()}")
+        if not all(np.isfinite(values)):
+            fail(f"{where}: a field is not a finite number: {line.strip()}")
+        if any(values[i] <= 0 for i in SIGMAS.get(kind, ())):
+            fail(f"{where}: a sigma is not positive: {line.strip()}")
+        if kind in IDS:
+            i = values[IDS[kind]]
+            if i != int(i) or not 0 <= i < 2**31:
+                fail(f"{where}: a landmark id must be a non-negative integer: "
+                     f"{line.strip()}")
+        if kind == "ODOM" and not values[1] > values[0]:
+            fail(f"{where}: t1 must be after t0: {line.strip()}")
         records.setdefault(kind, []).append(values)
     for kind in ("PRIOR_POSE", "PRIOR_LANDMARK", "RANGE_BEARING", "ODOM"):
         if kind not in records:
             fail(f"{path}: needs {kind} records (the peer's mean is the dead "
                  "reckoning, and every landmark needs a prior)")
-    data = {k: np.array(sorted(v)) for k, v in records.items()}
+    data = {k: np.array(v if k == "PRIOR_POSE" else sorted(v))
+            for k, v in records.items()}
+    for kind, column, what in (("PRIOR_LANDMARK", 0, "landmark prior"),
+                               ("GT_POSE", 0, "GT_POSE time")):
+        if kind in data and len(np.unique(data[kind][:, column])) < len(data[kind]):
+            fail(f"{path}: a duplicate {what}")
     unknown = set(data["RANGE_BEARING"][:, 1]) - set(data["PRIOR_LANDMARK"][:, 0])
     if unknown:
         fail(f"{path}: landmark {int(min(unknown))} is observed but has no "
@@ -80,11 +108,11 @@ def wrap(a):
     return (a + np.pi) % (2.0 * np.pi) - np.pi
 
 
-def dead_reckoning(prior, odom):
+def dead_reckoning(prior, odom, path):
     """Knot times and poses of the ODOM chain from the pose prior `prior`."""
     if odom[0, 0] != prior[0] or np.any(odom[1:, 0] != odom[:-1, 1]):
-        fail("the ODOM records must form one chain starting at the earliest "
-             "PRIOR_POSE")
+        fail(f"{path}: the ODOM records must form one chain starting at the "
+             "earliest PRIOR_POSE")
     pose = prior[1:4].copy()
     knots, poses = [prior[0]], [pose.copy()]
     for _, t1, dx, dy, dth, *_ in odom:
@@ -111,19 +139,34 @@ def hilbert_features(times, window, num_features, lengthscale, variance):
 class Model:
     def __init__(self, data, args):
         rb, odom = data["RANGE_BEARING"], data["ODOM"]
+        path = args.dataset
         self.priors = data["PRIOR_POSE"]
-        first = self.priors[np.argmin(self.priors[:, 0])]
+        first = self.priors[np.argmin(self.priors[:, 0])]  # First in the file.
+        if first[5] > LOOSE_HEADING_SIGMA:
+            fail(f"{path}: a start heading sigma above {LOOSE_HEADING_SIGMA} "
+                 "rad, which rff_slam re-estimates first and this peer does "
+                 "not")
         self.times = np.unique(np.concatenate(
             [rb[:, 0], self.priors[:, 0], odom[:, 0], odom[:, 1]]))
-        gaps = np.diff(self.times)
-        if gaps.size and gaps.max() > MAX_GAP_LENGTHSCALES * args.lengthscale:
-            fail(f"a gap of {gaps.max():g} s: rff_slam would split the run "
-                 "there, this peer has one global map")
-        queries = self.times
+        # Gaps between what the data cover: an ODOM record covers [t0, t1].
+        starts = np.concatenate([rb[:, 0], self.priors[:, 0], odom[:, 0]])
+        ends = np.concatenate([rb[:, 0], self.priors[:, 0], odom[:, 1]])
+        order = np.argsort(starts, kind="stable")
+        covered = np.maximum.accumulate(ends[order])
+        gaps = starts[order][1:] - covered[:-1]
+        max_gap = MAX_GAP_LENGTHSCALES * args.lengthscale
+        if gaps.size and gaps.max() > max_gap:
+            fail(f"{path}: a gap of {gaps.max():g} s in the data: rff_slam "
+                 "would split the run there, this peer has one global map")
+        # The window spans the data and the ground truth within max_gap of it.
+        begin, end = self.times.min(), self.times.max()
         if "GT_POSE" in data:
-            queries = np.concatenate([queries, data["GT_POSE"][:, 0]])
-        self.window = (queries.min(), queries.max())
-        self.knots, self.knot_poses = dead_reckoning(first, odom)
+            gt = data["GT_POSE"][:, 0]
+            gt = gt[(gt >= begin - max_gap) & (gt <= end + max_gap)]
+            begin, end = min(begin, gt.min(initial=begin)), max(
+                end, gt.max(initial=end))
+        self.window = (begin, end)
+        self.knots, self.knot_poses = dead_reckoning(first, odom, path)
         self.anchor = self.mean_at(first[:1])[0]
         self.delta_sigma = min(first[5], LOOSE_HEADING_SIGMA)
         self.args = args
@@ -311,11 +354,11 @@ def main():
     parser.add_argument("--kernel_variance", type=float, default=100.0)
     parser.add_argument("--heading_kernel_variance", type=float, default=0.25)
     args = parser.parse_args()
-    if args.num_features < 1 or not (args.lengthscale > 0 and
-                                     args.kernel_variance > 0 and
-                                     args.heading_kernel_variance > 0):
-        fail("--num_features must be 1 or more and the kernel's values more "
-             "than 0")
+    values = (args.lengthscale, args.kernel_variance,
+              args.heading_kernel_variance)
+    if args.num_features < 1 or not all(0 < v < np.inf for v in values):
+        fail("--num_features must be 1 or more and the kernel's values finite "
+             "and more than 0")
     data = read_rffd(args.dataset)
     start = time.perf_counter()
     model = Model(data, args)
@@ -323,6 +366,15 @@ def main():
     params[model.num_weights + 1:] = model.lm_prior.ravel()
     params, cost, iterations = levenberg_marquardt(model, params)
     seconds = time.perf_counter() - start
+    # rff_slam turns the mean exactly and solves again past this error.
+    delta = params[model.delta]
+    second_order = (np.array([[np.cos(delta) - 1, -np.sin(delta) + delta],
+                              [np.sin(delta) - delta, np.cos(delta) - 1]]))
+    arms = model.mean[:, :2] - model.anchor[:2]
+    if np.linalg.norm(arms @ second_order.T, axis=1).max() > 0.01:
+        fail(f"{args.dataset}: the mean turned by {delta:g} rad, beyond its "
+             "first-order form, where rff_slam turns it exactly and solves "
+             "again")
     ape = None
     if "GT_POSE" in data:
         truth = data["GT_POSE"]

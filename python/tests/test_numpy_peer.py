@@ -63,9 +63,26 @@ def test_peer_reaches_the_same_map_with_near_landmarks(paper_seed_3,
     assert_same_map(paper_seed_3, tmp_path, 100)
 
 
+GOOD = ("RFFD 1\nPRIOR_POSE 0 0 0 0 0.1 0.1\nPRIOR_LANDMARK 0 1 1 1\n"
+        "RANGE_BEARING 0 0 1.4 0.7 0.1 0.1\nODOM 0 1 1 0 0 0.1 0.1 0.1\n")
+
+
 @pytest.mark.parametrize("content, message", [
+    ("PRIOR_POSE 0 0 0 0 0.1 0.1\n",
+     ":1: the first record must be the header RFFD 1"),
     ("RFFD 1\nPRIOR_POSE 0 0 0 0 0.1 0.1\nRANGE 0 0 1.4 0.1\n",
      ":3: RANGE records are outside this peer's model"),
+    ("RFFD 1\nPRIOR_POSE 0 0 0 0 0.1 nan\n",
+     ":2: a field is not a finite number: PRIOR_POSE 0 0 0 0 0.1 nan"),
+    ("RFFD 1\nPRIOR_LANDMARK 0 1 1 0\n",
+     ":2: a sigma is not positive: PRIOR_LANDMARK 0 1 1 0"),
+    ("RFFD 1\nPRIOR_LANDMARK 1.5 1 1 1\n",
+     ":2: a landmark id must be a non-negative integer: "
+     "PRIOR_LANDMARK 1.5 1 1 1"),
+    (GOOD + "PRIOR_LANDMARK 0 1 1 1\n", ": a duplicate landmark prior"),
+    (GOOD.replace("0.1 0.1\nPRIOR_LANDMARK", "0.1 0.6\nPRIOR_LANDMARK"),
+     ": a start heading sigma above 0.5 rad, which rff_slam re-estimates "
+     "first and this peer does not"),
     ("RFFD 1\nPRIOR_POSE 0 0 0 0 0.1\n",
      ":2: not a record this peer reads: PRIOR_POSE 0 0 0 0 0.1"),
     ("RFFD 1\nPRIOR_POSE 0 0 0 x 0.1 0.1\n",
@@ -94,8 +111,8 @@ def test_peer_refuses_odometry_that_is_not_one_chain(tmp_path):
     done = peer(path)
     assert done.returncode == 1
     assert done.stderr.strip() == (
-        "numpy_dense_lm.py: the ODOM records must form one chain starting at "
-        "the earliest PRIOR_POSE")
+        f"numpy_dense_lm.py: {path}: the ODOM records must form one chain "
+        "starting at the earliest PRIOR_POSE")
 
 
 def test_missing_file_is_named(tmp_path):
@@ -103,3 +120,23 @@ def test_missing_file_is_named(tmp_path):
     assert done.returncode == 1
     assert done.stderr.startswith(
         f"numpy_dense_lm.py: {tmp_path / 'none.rffd'}: cannot read:")
+
+
+def test_peer_refuses_a_mean_turned_past_first_order(tmp_path):
+    # A start heading 20 degrees off with sigma 0.3 rad: rff_slam turns its
+    # mean exactly (twice) and solves again; the peer's turn stays linear.
+    simulated, turned = tmp_path / "s4.rffd", tmp_path / "turned.rffd"
+    done = run(app("rff_simulate"), "--preset=paper", "--seed=4",
+               f"--output={simulated}")
+    assert done.returncode == 0, done.stderr
+    done = run(app("rff_perturb"), f"--input={simulated}",
+               f"--output={turned}", "--start_heading_offset_deg=20",
+               "--start_heading_sigma=0.3")
+    assert done.returncode == 0, done.stderr
+    done = peer(turned, "--num_features=20")
+    assert done.returncode == 1
+    assert done.stderr.startswith(
+        f"numpy_dense_lm.py: {turned}: the mean turned by -0.2167")
+    assert done.stderr.strip().endswith(
+        "beyond its first-order form, where rff_slam turns it exactly and "
+        "solves again")
