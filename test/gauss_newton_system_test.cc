@@ -51,8 +51,8 @@ TEST(GaussNewtonSystemTest, EveryFactorizationSolvesTheSameSystem) {
   EXPECT_LT((sparse.Solve(z) - expected).cwiseAbs().maxCoeff(), 1e-9 * scale);
 }
 
-// All columns at once give, bit for bit, what Eigen's own solve gives one
-// column at a time (the same operations in the same order).
+// All columns at once give, bit for bit (a zero's sign aside), what Eigen's own
+// solve gives one column at a time (the same operations in the same order).
 TEST(GaussNewtonSystemTest, ManyColumnsSolveAsEigenSolvesEach) {
   const int t = 60;
   const RowMajorSparse jacobian = ChainWithLandmarks(t, 4, 11);

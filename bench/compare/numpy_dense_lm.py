@@ -20,8 +20,10 @@ the dense normal equations, stopped like Ceres at a relative cost change of
 Usage: numpy_dense_lm.py DATASET.rffd [--num_features=100] [--lengthscale=5]
        [--kernel_variance=100] [--heading_kernel_variance=0.25]
 Prints one JSON line: solve seconds, iterations, final cost, APE. A file
-outside the model (no odometry, RANGE or BEARING records, gaps that rff_slam
-would split the run at) is refused with a message and exit status 1.
+that rff_slam would refuse or model differently (no odometry, RANGE or
+BEARING records, gaps that rff_slam would split the run at, a loose start
+heading, bad values) is refused with a message and exit status 1
+(bench/compare/README.md lists the cases).
 """
 import argparse
 import json
