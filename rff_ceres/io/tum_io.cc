@@ -54,6 +54,17 @@ bool ParseTum(std::istream* input, const std::string& source,
       *error = reader.Error("quaternion has zero norm");
       return false;
     }
+    // Planar poses only: a 3-D pose's yaw and (x, y) would be compared as
+    // if it were one, silently.
+    constexpr double kMaxOffPlane = 1e-6;  // m, and rad of tilt.
+    const double tilt = 2.0 * std::hypot(qx, qy) / std::sqrt(norm2);
+    if (!(std::abs(v[3]) <= kMaxOffPlane) || !(tilt <= kMaxOffPlane)) {
+      *error = reader.Error(
+          "not a planar pose (z = " + FormatNumber(v[3]) + " m, tilt " +
+          FormatNumber(tilt) + " rad; at most " + FormatNumber(kMaxOffPlane) +
+          "): the tools compare planar trajectories, z = 0 and qx = qy = 0");
+      return false;
+    }
     if (!poses->empty() && !(v[0] > poses->back().t)) {
       *error = reader.Error("time " + FormatNumber(v[0]) +
                             " does not increase (previous " +

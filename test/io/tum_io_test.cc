@@ -66,7 +66,14 @@ INSTANTIATE_TEST_SUITE_P(
         BadTum{"0 0 0 0 0 0 0 nan\n", "t.tum:1: field 8 'nan'"},
         BadTum{"0 0 0 0 0 0 0 0\n", "t.tum:1: quaternion has zero norm"},
         BadTum{"1 0 0 0 0 0 0 1\n1 0 0 0 0 0 0 1\n",
-               "t.tum:2: time 1 does not increase"}),
+               "t.tum:2: time 1 does not increase"},
+        BadTum{"0 0 0 0.5 0 0 0 1\n",
+               "t.tum:1: not a planar pose (z = 0.5 m, tilt 0 rad; at most "
+               "1e-06): the tools compare planar trajectories, z = 0 and qx = "
+               "qy = 0"},
+        BadTum{"0 0 0 0 0.1 0 0 1\n",
+               "t.tum:1: not a planar pose (z = 0 m, "
+               "tilt 0.199"}),
     [](const ::testing::TestParamInfo<BadTum>& info) {
       return "Case" + std::to_string(info.index);
     });
