@@ -1,6 +1,8 @@
 #include "rff_ceres/gauss_newton_system.h"
 
 #include <algorithm>
+#include <utility>
+#include <vector>
 
 #include "Eigen/LU"
 
@@ -55,7 +57,7 @@ bool DenseRows(const RowMajorSparse& j, int t) {
 }
 
 // A = J_t^T J_t (lower triangle), J_t the first t columns: dense SYRK over
-// chunks of rows, or the sparse product for sparse rows.
+// chunks of rows, or row by row for sparse rows.
 Eigen::MatrixXd LeadingGram(const RowMajorSparse& j, int t) {
   Eigen::MatrixXd a = Eigen::MatrixXd::Zero(t, t);
   if (DenseRows(j, t)) {
@@ -73,15 +75,21 @@ Eigen::MatrixXd LeadingGram(const RowMajorSparse& j, int t) {
           chunk.topRows(rows).transpose());
     }
   } else {
-    std::vector<Eigen::Triplet<double>> entries;
+    // Each row's outer product straight into A's lower triangle: A is t x t
+    // and stays in cache, where a sparse product allocates and scatters.
+    std::vector<std::pair<Eigen::Index, double>> row;
     for (Eigen::Index r = 0; r < j.rows(); ++r) {
+      row.clear();
       for (RowMajorSparse::InnerIterator it(j, r); it; ++it) {
-        if (it.col() < t) entries.emplace_back(r, it.col(), it.value());
+        if (it.col() < t) row.emplace_back(it.col(), it.value());
+      }
+      // Columns ascend within a row: entry k's partners at or above it.
+      for (std::size_t k = 0; k < row.size(); ++k) {
+        for (std::size_t i = k; i < row.size(); ++i) {
+          a(row[i].first, row[k].first) += row[i].second * row[k].second;
+        }
       }
     }
-    Eigen::SparseMatrix<double> leading(j.rows(), t);
-    leading.setFromTriplets(entries.begin(), entries.end());
-    a = Eigen::MatrixXd(leading.transpose() * leading);
   }
   a.triangularView<Eigen::StrictlyUpper>() = a.transpose();
   return a;
