@@ -121,7 +121,8 @@ bool SchurFormFits(int t, Eigen::Index m) {
 }
 
 GaussNewtonSystem::GaussNewtonSystem(const RowMajorSparse& jacobian, int t,
-                                     Factorization factorization) {
+                                     Factorization factorization,
+                                     SparseAnalysis* analysis) {
   // A Schur complement singular to rounding is retried as the sparse LDLT
   // (solves only), as is a system without the form.
   const bool sparse_fallback = factorization != Factorization::kSchurOnly;
@@ -135,9 +136,25 @@ GaussNewtonSystem::GaussNewtonSystem(const RowMajorSparse& jacobian, int t,
   b_ = Eigen::MatrixXd();
   c_inverse_.clear();
   if (!sparse_fallback) return;
-  sparse_.compute(Eigen::SparseMatrix<double>(jacobian.transpose()) * jacobian);
+  const Eigen::SparseMatrix<double> h =
+      Eigen::SparseMatrix<double>(jacobian.transpose()) * jacobian;
+  if (analysis == nullptr) {
+    sparse_->compute(h);
+  } else {
+    sparse_ = &analysis->ldlt;
+    const std::vector<int> outer(h.outerIndexPtr(),
+                                 h.outerIndexPtr() + h.outerSize() + 1);
+    const std::vector<int> inner(h.innerIndexPtr(),
+                                 h.innerIndexPtr() + h.nonZeros());
+    if (outer != analysis->outer || inner != analysis->inner) {
+      sparse_->analyzePattern(h);
+      analysis->outer = outer;
+      analysis->inner = inner;
+    }
+    sparse_->factorize(h);
+  }
   positive_definite_ =
-      sparse_.info() == Eigen::Success && sparse_.vectorD().minCoeff() > 0.0;
+      sparse_->info() == Eigen::Success && sparse_->vectorD().minCoeff() > 0.0;
 }
 
 // False when a row touches two landmarks (not this structure) or a
@@ -204,7 +221,7 @@ Eigen::VectorXd GaussNewtonSystem::ApplyCInverse(
 }
 
 Eigen::MatrixXd GaussNewtonSystem::Solve(const Eigen::MatrixXd& z) const {
-  if (!structured_) return SolveLdltByRows(sparse_, z);
+  if (!structured_) return SolveLdltByRows(*sparse_, z);
   const Eigen::Index t = b_.rows(), m = b_.cols();
   Eigen::MatrixXd u(z.rows(), z.cols());
   for (Eigen::Index k = 0; k < z.cols(); ++k) {

@@ -51,12 +51,24 @@ enum class Factorization {
   kSparse,
 };
 
+// The sparse LDLT's symbolic analysis (fill-reducing ordering, elimination
+// tree) of one pattern of H, kept between systems of the same structure
+// (the rounds of the learned scales). It depends on the pattern alone, so
+// reusing it changes no digit.
+struct SparseAnalysis {
+  std::vector<int> outer, inner;  // The pattern analysed.
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt;
+};
+
 class GaussNewtonSystem {
  public:
   // `jacobian`'s first `t` columns are the leading blocks, the rest the
-  // landmarks, two each.
+  // landmarks, two each. With `analysis`, the sparse LDLT is factorised in
+  // it, analysed only when H's pattern is not the one it holds; it must
+  // outlive this system and serve one system at a time.
   GaussNewtonSystem(const RowMajorSparse& jacobian, int t,
-                    Factorization factorization);
+                    Factorization factorization,
+                    SparseAnalysis* analysis = nullptr);
 
   // Whether the Schur form was built (covariances are available).
   bool structured() const { return structured_; }
@@ -78,7 +90,9 @@ class GaussNewtonSystem {
   Eigen::MatrixXd b_;
   std::vector<Eigen::Matrix2d> c_inverse_;
   Eigen::LDLT<Eigen::MatrixXd> schur_;
-  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> sparse_;
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> own_sparse_;
+  // own_sparse_ or the analysis's.
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>* sparse_ = &own_sparse_;
 };
 
 }  // namespace rff

@@ -100,11 +100,12 @@ bool LearnScales(const Dataset& dataset,
   std::set<VarianceGroup> kept;  // Noise sigmas back at the stated ones.
   std::set<VarianceGroup> learned;  // Noise factors the data estimated.
   const ceres::Solver::Options placing_options = PlacingOptions(ceres_options);
+  SparseAnalysis analysis;  // The rounds' problems share one structure.
   for (int round = 0; round < kMaxScaleRounds; ++round) {
     VarianceComponents components;
     std::string why;
     if (!EstimateVarianceComponents(problem->get(), VarianceComponentOptions(),
-                                    &components, &why)) {
+                                    &components, &why, &analysis)) {
       // Data that leave part of the run beyond double precision (a pose
       // after a gap of days): the scales stay as they are, and say so.
       result->scales_not_learned = why;

@@ -53,7 +53,7 @@ bool Linearize(ceres::Problem* problem,
 bool EstimateVarianceComponents(SlamProblem* problem,
                                 const VarianceComponentOptions& options,
                                 VarianceComponents* components,
-                                std::string* error) {
+                                std::string* error, SparseAnalysis* analysis) {
   *components = VarianceComponents();
   std::vector<ceres::ResidualBlockId> ids;
   problem->problem()->GetResidualBlocks(&ids);
@@ -73,7 +73,8 @@ bool EstimateVarianceComponents(SlamProblem* problem,
   const GaussNewtonSystem hessian(jacobian, num_leading,
                                   problem->model().HasDenseReducedSystem()
                                       ? Factorization::kSchurOrSparse
-                                      : Factorization::kSparse);
+                                      : Factorization::kSparse,
+                                  analysis);
   if (!hessian.positive_definite()) {
     *error = "the Gauss-Newton Hessian is not positive definite";
     return false;

@@ -21,6 +21,7 @@
 
 #include "Eigen/SparseCore"
 #include "ceres/problem.h"
+#include "rff_ceres/gauss_newton_system.h"
 #include "rff_ceres/slam_problem.h"
 
 namespace rff {
@@ -46,10 +47,13 @@ using VarianceComponents = std::array<VarianceComponent, kNumVarianceGroups>;
 
 // The factors at the problem's current values (call at a MAP). Fails when
 // the problem cannot be evaluated or its Hessian is not positive definite.
+// `analysis`, when given, keeps the sparse factorisation's analysis for
+// the next call on a problem of the same structure.
 bool EstimateVarianceComponents(SlamProblem* problem,
                                 const VarianceComponentOptions& options,
                                 VarianceComponents* components,
-                                std::string* error);
+                                std::string* error,
+                                SparseAnalysis* analysis = nullptr);
 
 // The residuals and Jacobian of `blocks` (in that order, through their
 // robust losses) at the problem's current values; the Jacobian's columns are
