@@ -51,6 +51,37 @@ TEST(GaussNewtonSystemTest, EveryFactorizationSolvesTheSameSystem) {
   EXPECT_LT((sparse.Solve(z) - expected).cwiseAbs().maxCoeff(), 1e-9 * scale);
 }
 
+// Rows over separate runs of leading columns (two windows' features, as
+// where windows blend), sparse enough for the row blocks: the Schur form
+// solves the system the dense LDLT of J^T J solves.
+TEST(GaussNewtonSystemTest, RowsOverSeparateRunsGiveTheSameSystem) {
+  const int t = 80, landmarks = 6;
+  std::mt19937 rng(21);
+  std::normal_distribution<double> normal;
+  std::vector<Eigen::Triplet<double>> entries;
+  int row = 0;
+  for (int i = 0; i + 23 < t; ++i) {
+    for (int k = 0; k < 4; ++k, ++row) {
+      for (const int column : {i, i + 1, i + 2, i + 20, i + 21, i + 23}) {
+        entries.emplace_back(row, column, normal(rng));
+      }
+      const int landmark = t + 2 * (row % landmarks);
+      entries.emplace_back(row, landmark, normal(rng));
+      entries.emplace_back(row, landmark + 1, normal(rng));
+    }
+  }
+  RowMajorSparse jacobian(row, t + 2 * landmarks);
+  jacobian.setFromTriplets(entries.begin(), entries.end());
+  const GaussNewtonSystem schur(jacobian, t, Factorization::kSchurOnly);
+  ASSERT_TRUE(schur.positive_definite());
+  const Eigen::MatrixXd h = Eigen::MatrixXd(
+      Eigen::SparseMatrix<double>(jacobian.transpose()) * jacobian);
+  const Eigen::VectorXd z = Eigen::VectorXd::LinSpaced(h.rows(), -1.0, 2.0);
+  const Eigen::VectorXd expected = h.ldlt().solve(z);
+  EXPECT_LT((schur.Solve(z) - expected).cwiseAbs().maxCoeff(),
+            1e-9 * expected.cwiseAbs().maxCoeff());
+}
+
 // All columns at once give, bit for bit (a zero's sign aside), what Eigen's own
 // solve gives one column at a time (the same operations in the same order).
 TEST(GaussNewtonSystemTest, ManyColumnsSolveAsEigenSolvesEach) {
