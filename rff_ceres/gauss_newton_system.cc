@@ -161,14 +161,16 @@ GaussNewtonSystem::GaussNewtonSystem(const RowMajorSparse& jacobian, int t,
     sparse_->compute(h);
   } else {
     sparse_ = &analysis->ldlt;
-    const std::vector<int> outer(h.outerIndexPtr(),
-                                 h.outerIndexPtr() + h.outerSize() + 1);
-    const std::vector<int> inner(h.innerIndexPtr(),
-                                 h.innerIndexPtr() + h.nonZeros());
-    if (outer != analysis->outer || inner != analysis->inner) {
+    const int* outer = h.outerIndexPtr();
+    const int* inner = h.innerIndexPtr();
+    const std::size_t num_outer = h.outerSize() + 1, num_inner = h.nonZeros();
+    if (!std::equal(outer, outer + num_outer, analysis->outer.begin(),
+                    analysis->outer.end()) ||
+        !std::equal(inner, inner + num_inner, analysis->inner.begin(),
+                    analysis->inner.end())) {
       sparse_->analyzePattern(h);
-      analysis->outer = outer;
-      analysis->inner = inner;
+      analysis->outer.assign(outer, outer + num_outer);
+      analysis->inner.assign(inner, inner + num_inner);
     }
     sparse_->factorize(h);
   }

@@ -29,7 +29,6 @@ inline std::string OptionError(const std::string& flag,
   return message;
 }
 
-// `value` must be finite and > 0 (>= 0); otherwise `error` names the flag.
 // Positive and normal: the floor of every "more than 0" option.
 inline bool IsNormalPositive(double value) {
   return value >= std::numeric_limits<double>::min() && std::isfinite(value);
@@ -44,6 +43,7 @@ inline std::string WhyNotOption(double value) {
   }
   return "";
 }
+// `value` must be finite and > 0 (>= 0); otherwise `error` names the flag.
 inline bool CheckPositiveOption(double value, const char* flag,
                                 std::string* error) {
   if (IsNormalPositive(value)) return true;
@@ -64,10 +64,7 @@ inline bool CheckPositiveUpToOption(double value, const std::string& flag,
 }
 inline bool CheckNonNegativeOption(double value, const char* flag,
                                    std::string* error) {
-  if ((value == 0.0 || value >= std::numeric_limits<double>::min()) &&
-      std::isfinite(value)) {
-    return true;
-  }
+  if (value == 0.0 || IsNormalPositive(value)) return true;
   *error =
       OptionError(flag, FormatNumber(value), WhyNotOption(value), "0 or more");
   return false;
