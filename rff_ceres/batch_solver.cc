@@ -6,7 +6,6 @@
 #include "glog/logging.h"
 #include "rff_ceres/ceres_solve.h"
 #include "rff_ceres/io/text_parser.h"
-#include "rff_ceres/linear_system_size.h"
 #include "rff_ceres/mean/spline_mean.h"
 #include "rff_ceres/mean_rotation.h"
 
@@ -86,14 +85,10 @@ bool SolveBatch(const Dataset& dataset, const SlamOptions& options,
     (*problem)->set_odometry_calibration(result->odometry_calibration);
     if (!(*problem)->Build(dataset, *landmarks, error)) return false;
     ChooseLinearSolver(options.solver, *model, &ceres_options, result);
-    SetOrdering(problem->get(), &ceres_options);
-    if (!CheckLinearSystemFits(problem->get(), ceres_options,
-                               options.solver.max_memory_gb, error)) {
-      return false;
-    }
-    ceres::Solve(ceres_options, (*problem)->problem(), &result->summary);
+    const bool solved =
+        RunSolve(options.solver, ceres_options, problem->get(), result, error);
     VLOG(1) << result->summary.FullReport();
-    if (!CheckSolve(result->summary, problem->get(), error)) return false;
+    if (!solved) return false;
     result->converged = result->summary.termination_type == ceres::CONVERGENCE;
     result->total_iterations +=
         static_cast<int>(result->summary.iterations.size());

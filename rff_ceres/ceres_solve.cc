@@ -4,11 +4,18 @@
 
 #include "ceres/types.h"
 #include "glog/logging.h"
+#include "rff_ceres/banded_minimizer.h"
+#include "rff_ceres/io/text_parser.h"
+#include "rff_ceres/linear_system_size.h"
 #include "rff_ceres/option_error.h"
 #include "rff_ceres/slam_solver.h"
 
 namespace rff {
 namespace {
+
+// Auto takes BANDED_CHOLESKY up to the work per parameter of a band of 32
+// columns (32^2 / 2 multiply-adds).
+constexpr double kMaxBandedWorkPerParameter = 512.0;
 
 // The preconditioners a flag can choose (SUBSET cannot be set up from one).
 constexpr char kPreconditioners[] =
@@ -21,14 +28,18 @@ bool ToCeresOptions(const SolverOptions& options,
                     ceres::Solver::Options* ceres_options, std::string* error) {
   // "auto" is settled per problem by ChooseLinearSolver; until then the
   // sparse Cholesky, whose options are always valid.
-  std::string name = options.linear_solver == "auto" ? "SPARSE_NORMAL_CHOLESKY"
-                                                     : options.linear_solver;
+  // BANDED_CHOLESKY is not Ceres's: its Ceres options are the sparse
+  // Cholesky's, for the problems it does not take.
+  const bool banded = options.linear_solver == kBandedCholesky;
+  std::string name = options.linear_solver == "auto" || banded
+                         ? "SPARSE_NORMAL_CHOLESKY"
+                         : options.linear_solver;
   if (!ceres::StringToLinearSolverType(name,
                                        &ceres_options->linear_solver_type)) {
     *error = OptionError("linear_solver", options.linear_solver,
                          "unknown linear solver",
-                         "auto, DENSE_SCHUR, SPARSE_SCHUR, ITERATIVE_SCHUR, "
-                         "DENSE_QR, DENSE_NORMAL_CHOLESKY, "
+                         "auto, BANDED_CHOLESKY, DENSE_SCHUR, SPARSE_SCHUR, "
+                         "ITERATIVE_SCHUR, DENSE_QR, DENSE_NORMAL_CHOLESKY, "
                          "SPARSE_NORMAL_CHOLESKY or CGNR");
     return false;
   }
@@ -67,6 +78,14 @@ bool ToCeresOptions(const SolverOptions& options,
     *error = OptionError("trust_region_strategy", options.trust_region_strategy,
                          "unknown trust region strategy",
                          "LEVENBERG_MARQUARDT or DOGLEG");
+    return false;
+  }
+  if (banded &&
+      ceres_options->trust_region_strategy_type != ceres::LEVENBERG_MARQUARDT) {
+    *error = OptionError("trust_region_strategy", options.trust_region_strategy,
+                         "--linear_solver=BANDED_CHOLESKY runs "
+                         "Levenberg-Marquardt only",
+                         "LEVENBERG_MARQUARDT with BANDED_CHOLESKY");
     return false;
   }
   for (const auto& [flag, count] :
@@ -139,6 +158,67 @@ void SetOrdering(SlamProblem* problem, ceres::Solver::Options* options) {
   } else {
     options->linear_solver_ordering.reset();
   }
+}
+
+bool RunSolve(const SolverOptions& solver, ceres::Solver::Options ceres_options,
+              SlamProblem* problem, SlamResult* result, std::string* error) {
+  const bool asked = solver.linear_solver == kBandedCholesky;
+  if (asked ||
+      (solver.linear_solver == "auto" &&
+       ceres_options.linear_solver_type == ceres::SPARSE_NORMAL_CHOLESKY &&
+       ceres_options.trust_region_strategy_type ==
+           ceres::LEVENBERG_MARQUARDT)) {
+    const std::vector<double*> order = problem->BandOrder();
+    BandedSize size;
+    std::string why;
+    const int n = problem->problem()->NumParameters();
+    if (BandedSolvable(*problem->problem(), order, &size, &why)) {
+      // The envelope twice: H and the factor of the damped system.
+      const double bytes = 16.0 * static_cast<double>(size.entries);
+      const double limit = MemoryLimitBytes(solver.max_memory_gb);
+      if (bytes > limit) {
+        why = "its envelope needs about " + FormatNumber(bytes / 1e9) +
+              " GB, more than the " + FormatNumber(limit / 1e9) +
+              " GB allowed by --max_memory_gb";
+      } else if (!asked &&
+                 size.multiply_adds > kMaxBandedWorkPerParameter * n) {
+        // Landmarks seen over the whole run fill their rows of the factor;
+        // a fill-reducing sparse Cholesky then does better.
+        why = std::to_string(std::llround(size.multiply_adds / n)) +
+              " multiply-adds per parameter in its factorisation, more than " +
+              FormatNumber(kMaxBandedWorkPerParameter);
+      }
+    }
+    if (why.empty()) {
+      if (!asked) {
+        result->linear_solver = kBandedCholesky;
+        result->linear_solver_reason =
+            "banded states: Levenberg-Marquardt on a Cholesky of the whole "
+            "system in time order";
+      }
+      MinimizeBanded(ceres_options, order, problem->problem(),
+                     &result->summary);
+      return CheckSolve(result->summary, problem, error);
+    }
+    if (asked) {
+      *error = OptionError("linear_solver", kBandedCholesky, why,
+                           "auto or a Ceres linear solver");
+      return false;
+    }
+    const std::string cannot =
+        " (not " + std::string(kBandedCholesky) + ": " + why + ")";
+    if (result->linear_solver_reason.find(cannot) == std::string::npos) {
+      result->linear_solver_reason += cannot;
+    }
+  }
+  // Ceres's preprocessor edits the ordering it is given: a fresh one per solve.
+  SetOrdering(problem, &ceres_options);
+  if (!CheckLinearSystemFits(problem, ceres_options, solver.max_memory_gb,
+                             error)) {
+    return false;
+  }
+  ceres::Solve(ceres_options, problem->problem(), &result->summary);
+  return CheckSolve(result->summary, problem, error);
 }
 
 bool CheckSolve(const ceres::Solver::Summary& summary, SlamProblem* problem,

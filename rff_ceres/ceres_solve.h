@@ -53,6 +53,15 @@ void ChooseLinearSolver(const SolverOptions& solver,
 // Schur solvers eliminate the landmarks first; the others get no ordering.
 void SetOrdering(SlamProblem* problem, ceres::Solver::Options* options);
 
+// Solves `problem` from its current values into result->summary with the
+// linear solver settled by ChooseLinearSolver: BANDED_CHOLESKY where asked,
+// or where "auto" settled on the sparse Cholesky and the problem has no
+// bounds (the choice and why then recorded in `result`); otherwise Ceres,
+// once the system is known to fit in memory. False with the cause in
+// `error` when it does not fit or the solve fails (CheckSolve).
+bool RunSolve(const SolverOptions& solver, ceres::Solver::Options ceres_options,
+              SlamProblem* problem, SlamResult* result, std::string* error);
+
 // A solve is accepted only if Ceres did not fail and the cost is finite.
 // On failure the first non-finite residual is named, when there is one.
 bool CheckSolve(const ceres::Solver::Summary& summary, SlamProblem* problem,

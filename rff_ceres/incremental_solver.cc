@@ -137,14 +137,7 @@ bool IncrementalSolver::SolveUpdate(double now, int num_measurements,
   update.t = std::min(now, data_end_);
   update.num_measurements = num_measurements;
   update.active_blocks = SetActiveBlocks(now);
-  // The preprocessor edits the ordering it is given: a fresh one per solve.
-  SetOrdering(slam_, &ceres_options_);
-  if (!CheckLinearSystemFits(slam_, ceres_options_,
-                             options_.solver.max_memory_gb, error)) {
-    return false;
-  }
-  ceres::Solve(ceres_options_, ceres_problem_, &result_->summary);
-  if (!CheckSolve(result_->summary, slam_, error)) {
+  if (!RunSolve(options_.solver, ceres_options_, slam_, result_, error)) {
     *error = "update at t = " + FormatNumber(update.t) + ": " + *error;
     return false;
   }

@@ -214,6 +214,10 @@ class SlamProblem {
   // and odometry calibrations in group 3. Null without landmarks: Ceres then
   // finds its own independent set to eliminate.
   std::shared_ptr<ceres::ParameterBlockOrdering> Ordering();
+  // Every parameter block in the columns of a time-ordered system: the
+  // trajectory blocks in the model's (time) order, then the shared blocks,
+  // the calibrations and the landmarks, which rows from the whole run touch.
+  std::vector<double*> BandOrder();
 
  private:
   // Parameter blocks of a cost over `maps` (model block ids rewritten to the

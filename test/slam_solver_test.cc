@@ -117,6 +117,43 @@ TEST(SlamSolverTest, WnoaFollowsOdometryThroughAGapInTheObservations) {
 // The answer does not depend on where the origin is: the same run 1e9 m
 // away (Ceres's parameter tolerance is relative to the parameters' size,
 // which stopped such a solve two iterations in, at 0.45 m instead of 0.22).
+// The banded Levenberg-Marquardt takes Ceres's steps on a WNOA problem: the
+// same iterations and the same answer to rounding (one round, learning off,
+// so that no decision amplifies the last bits).
+TEST(SlamSolverTest, BandedCholeskyMatchesCeresSparseCholesky) {
+  SimulationOptions sim = PaperOptions(23);
+  sim.num_landmarks = 4;
+  Dataset dataset;
+  std::string error;
+  ASSERT_TRUE(Simulate(sim, &dataset, &error)) << error;
+  SlamOptions options;
+  options.prior = "wnoa";
+  options.learn_hyperparameters = "off";
+  SlamResult banded, ceres_side;
+  options.solver.linear_solver = "BANDED_CHOLESKY";
+  ASSERT_TRUE(RunSlam(dataset, options, &banded, &error)) << error;
+  options.solver.linear_solver = "SPARSE_NORMAL_CHOLESKY";
+  ASSERT_TRUE(RunSlam(dataset, options, &ceres_side, &error)) << error;
+  EXPECT_EQ(banded.linear_solver, "BANDED_CHOLESKY");
+  EXPECT_EQ(banded.total_iterations, ceres_side.total_iterations);
+  EXPECT_GT(banded.total_iterations, 3);
+  EXPECT_NEAR(banded.summary.final_cost, ceres_side.summary.final_cost,
+              1e-9 * ceres_side.summary.final_cost);
+  ASSERT_EQ(banded.trajectory.size(), ceres_side.trajectory.size());
+  double largest = 0.0;
+  for (std::size_t i = 0; i < banded.trajectory.size(); ++i) {
+    largest = std::max(
+        {largest, std::abs(banded.trajectory[i].x - ceres_side.trajectory[i].x),
+         std::abs(banded.trajectory[i].y - ceres_side.trajectory[i].y)});
+  }
+  EXPECT_LT(largest, 1e-9);
+  // Auto takes it where landmarks are few.
+  options.solver.linear_solver = "auto";
+  SlamResult automatic;
+  ASSERT_TRUE(RunSlam(dataset, options, &automatic, &error)) << error;
+  EXPECT_EQ(automatic.linear_solver, "BANDED_CHOLESKY");
+}
+
 TEST(SlamSolverTest, ShiftingTheSceneShiftsTheAnswer) {
   Dataset dataset;
   std::string error;
@@ -420,9 +457,25 @@ INSTANTIATE_TEST_SUITE_P(
         BadOption{"UnknownLinearSolver",
                   [](SlamOptions* o) { o->solver.linear_solver = "MAGIC"; },
                   "--linear_solver=MAGIC: unknown linear solver; allowed "
-                  "auto, DENSE_SCHUR, SPARSE_SCHUR, ITERATIVE_SCHUR, "
-                  "DENSE_QR, DENSE_NORMAL_CHOLESKY, SPARSE_NORMAL_CHOLESKY or "
-                  "CGNR"},
+                  "auto, BANDED_CHOLESKY, DENSE_SCHUR, SPARSE_SCHUR, "
+                  "ITERATIVE_SCHUR, DENSE_QR, DENSE_NORMAL_CHOLESKY, "
+                  "SPARSE_NORMAL_CHOLESKY or CGNR"},
+        BadOption{"BandedCholeskyWithDogleg",
+                  [](SlamOptions* o) {
+                    o->solver.linear_solver = "BANDED_CHOLESKY";
+                    o->solver.trust_region_strategy = "DOGLEG";
+                  },
+                  "--trust_region_strategy=DOGLEG: --linear_solver="
+                  "BANDED_CHOLESKY runs Levenberg-Marquardt only; allowed "
+                  "LEVENBERG_MARQUARDT with BANDED_CHOLESKY"},
+        BadOption{"BandedCholeskyWithBoundedCalibration",
+                  [](SlamOptions* o) {
+                    o->solver.linear_solver = "BANDED_CHOLESKY";
+                    o->problem.range_calibration.estimate = true;
+                  },
+                  "--linear_solver=BANDED_CHOLESKY: a parameter is bounded "
+                  "(a self-calibration); allowed auto or a Ceres linear "
+                  "solver"},
         BadOption{"CgnrWithSchurPreconditioner",
                   [](SlamOptions* o) {
                     o->solver.linear_solver = "CGNR";

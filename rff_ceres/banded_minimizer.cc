@@ -1,0 +1,474 @@
+#include "rff_ceres/banded_minimizer.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <map>
+
+#include "ceres/cost_function.h"
+#include "ceres/loss_function.h"
+#include "glog/logging.h"
+#include "rff_ceres/envelope_cholesky.h"
+
+namespace rff {
+namespace {
+
+double Now() {
+  return std::chrono::duration<double>(
+             std::chrono::steady_clock::now().time_since_epoch())
+      .count();
+}
+
+// One residual block: its cost, loss and parameter blocks, each with its
+// first column in the system (-1 for a constant block).
+struct ResidualTerm {
+  const ceres::CostFunction* cost = nullptr;
+  const ceres::LossFunction* loss = nullptr;
+  std::vector<double*> blocks;
+  std::vector<int> column;
+  std::vector<int> size;
+};
+
+// The problem's residuals over the variable blocks laid out in `order`.
+class BandedProblem {
+ public:
+  BandedProblem(const ceres::Problem& problem,
+                const std::vector<double*>& order) {
+    std::map<const double*, int> column;
+    for (double* block : order) {
+      if (problem.IsParameterBlockConstant(block)) continue;
+      column[block] = num_columns_;
+      variables_.push_back(block);
+      variable_sizes_.push_back(problem.ParameterBlockSize(block));
+      num_columns_ += variable_sizes_.back();
+    }
+    std::vector<ceres::ResidualBlockId> ids;
+    problem.GetResidualBlocks(&ids);
+    for (const ceres::ResidualBlockId id : ids) {
+      ResidualTerm term;
+      term.cost = problem.GetCostFunctionForResidualBlock(id);
+      term.loss = problem.GetLossFunctionForResidualBlock(id);
+      problem.GetParameterBlocksForResidualBlock(id, &term.blocks);
+      for (double* block : term.blocks) {
+        const auto it = column.find(block);
+        term.column.push_back(it == column.end() ? -1 : it->second);
+        term.size.push_back(problem.ParameterBlockSize(block));
+      }
+      terms_.push_back(std::move(term));
+    }
+  }
+
+  int num_columns() const { return num_columns_; }
+
+  // Row i of H = J^T J stores from the first column any residual couples
+  // to column i.
+  std::vector<int> EnvelopeFirst() const {
+    std::vector<int> first(num_columns_);
+    for (int i = 0; i < num_columns_; ++i) first[i] = i;
+    for (const ResidualTerm& term : terms_) {
+      int lowest = num_columns_;
+      for (const int c : term.column) {
+        if (c >= 0) lowest = std::min(lowest, c);
+      }
+      for (std::size_t a = 0; a < term.column.size(); ++a) {
+        if (term.column[a] < 0) continue;
+        for (int i = 0; i < term.size[a]; ++i) {
+          first[term.column[a] + i] =
+              std::min(first[term.column[a] + i], lowest);
+        }
+      }
+    }
+    return first;
+  }
+
+  Eigen::VectorXd Gather() const {
+    Eigen::VectorXd x(num_columns_);
+    int c = 0;
+    for (std::size_t b = 0; b < variables_.size(); ++b) {
+      for (int i = 0; i < variable_sizes_[b]; ++i) x[c++] = variables_[b][i];
+    }
+    return x;
+  }
+
+  void Scatter(const Eigen::VectorXd& x) const {
+    int c = 0;
+    for (std::size_t b = 0; b < variables_.size(); ++b) {
+      for (int i = 0; i < variable_sizes_[b]; ++i) variables_[b][i] = x[c++];
+    }
+  }
+
+  // The cost at x; false where a residual is not finite or a cost
+  // function fails.
+  bool Cost(const Eigen::VectorXd& x, double* cost) {
+    *cost = 0.0;
+    for (const ResidualTerm& term : terms_) {
+      double term_cost;
+      if (!Evaluate(term, x, /*jacobians=*/false, &term_cost)) return false;
+      *cost += term_cost;
+    }
+    return true;
+  }
+
+  // The cost, gradient g = J^T r and H = J^T J at x, with each robust
+  // loss's correction of the residual and Jacobian (Triggs et al. 2000,
+  // 4.3, clamped as Ceres's Corrector clamps it where rho'' <= 0).
+  bool Linearize(const Eigen::VectorXd& x, double* cost, Eigen::VectorXd* g,
+                 EnvelopeMatrix* h) {
+    *cost = 0.0;
+    g->setZero(num_columns_);
+    h->SetZero();
+    for (const ResidualTerm& term : terms_) {
+      double term_cost;
+      if (!Evaluate(term, x, /*jacobians=*/true, &term_cost)) return false;
+      *cost += term_cost;
+      Accumulate(term, g, h);
+    }
+    return true;
+  }
+
+ private:
+  bool Evaluate(const ResidualTerm& term, const Eigen::VectorXd& x,
+                bool jacobians, double* cost) {
+    const int rows = term.cost->num_residuals();
+    const std::size_t n = term.blocks.size();
+    parameters_.resize(n);
+    jacobian_rows_.resize(n);
+    jacobian_pointers_.resize(n);
+    for (std::size_t a = 0; a < n; ++a) {
+      parameters_[a] =
+          term.column[a] >= 0 ? x.data() + term.column[a] : term.blocks[a];
+      jacobian_rows_[a].resize(static_cast<std::size_t>(rows) * term.size[a]);
+      jacobian_pointers_[a] =
+          jacobians && term.column[a] >= 0 ? jacobian_rows_[a].data() : nullptr;
+    }
+    residual_.resize(rows);
+    if (!term.cost->Evaluate(parameters_.data(), residual_.data(),
+                             jacobians ? jacobian_pointers_.data() : nullptr) ||
+        !residual_.allFinite()) {
+      return false;
+    }
+    const double squared_norm = residual_.squaredNorm();
+    double rho[3] = {squared_norm, 1.0, 0.0};
+    if (term.loss != nullptr) term.loss->Evaluate(squared_norm, rho);
+    *cost = 0.5 * rho[0];
+    if (!jacobians) return std::isfinite(*cost);
+    const double sqrt_rho1 = std::sqrt(rho[1]);
+    double residual_scaling = sqrt_rho1, alpha_over_norm = 0.0;
+    if (squared_norm > 0.0 && rho[2] > 0.0) {
+      const double alpha =
+          1.0 - std::sqrt(1.0 + 2.0 * squared_norm * rho[2] / rho[1]);
+      residual_scaling = sqrt_rho1 / (1.0 - alpha);
+      alpha_over_norm = alpha / squared_norm;
+    }
+    for (std::size_t a = 0; a < n; ++a) {
+      if (jacobian_pointers_[a] == nullptr) continue;
+      Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic,
+                               Eigen::RowMajor>>
+          j(jacobian_rows_[a].data(), rows, term.size[a]);
+      if (!j.allFinite()) return false;
+      if (alpha_over_norm != 0.0) {
+        const Eigen::RowVectorXd rj = residual_.transpose() * j;
+        j -= alpha_over_norm * residual_ * rj;
+      }
+      j *= sqrt_rho1;
+    }
+    residual_ *= residual_scaling;
+    return std::isfinite(*cost);
+  }
+
+  // g += J^T r and the lower triangle of H += J^T J, block pair by pair.
+  void Accumulate(const ResidualTerm& term, Eigen::VectorXd* g,
+                  EnvelopeMatrix* h) const {
+    const int rows = static_cast<int>(residual_.size());
+    for (std::size_t a = 0; a < term.blocks.size(); ++a) {
+      if (term.column[a] < 0) continue;
+      const double* ja = jacobian_rows_[a].data();
+      const int sa = term.size[a], ca = term.column[a];
+      for (int k = 0; k < rows; ++k) {
+        for (int i = 0; i < sa; ++i)
+          (*g)[ca + i] += ja[k * sa + i] * residual_[k];
+      }
+      for (std::size_t b = 0; b < term.blocks.size(); ++b) {
+        const int cb = term.column[b];
+        if (cb < 0 || cb > ca) continue;
+        const double* jb = jacobian_rows_[b].data();
+        const int sb = term.size[b];
+        for (int i = 0; i < sa; ++i) {
+          double* hi = &(*h)(ca + i, cb);
+          const int width = a == b ? i + 1 : sb;
+          for (int k = 0; k < rows; ++k) {
+            const double v = ja[k * sa + i];
+            const double* jbk = jb + k * sb;
+            for (int j = 0; j < width; ++j) hi[j] += v * jbk[j];
+          }
+        }
+      }
+    }
+  }
+
+  std::vector<double*> variables_;  // In column order, with their sizes.
+  std::vector<int> variable_sizes_;
+  std::vector<ResidualTerm> terms_;
+  int num_columns_ = 0;
+  std::vector<const double*> parameters_;
+  std::vector<std::vector<double>> jacobian_rows_;
+  std::vector<double*> jacobian_pointers_;
+  Eigen::VectorXd residual_;
+};
+
+std::string Format(const char* format, double a, double b) {
+  char text[160];
+  std::snprintf(text, sizeof(text), format, a, b);
+  return text;
+}
+
+}  // namespace
+
+bool BandedSolvable(const ceres::Problem& problem,
+                    const std::vector<double*>& order, BandedSize* size,
+                    std::string* why) {
+  if (static_cast<int>(order.size()) != problem.NumParameterBlocks()) {
+    *why = "the column order does not hold every parameter block";
+    return false;
+  }
+  for (const double* block : order) {
+    if (!problem.HasParameterBlock(block)) {
+      *why = "the column order holds a block the problem does not";
+      return false;
+    }
+    if (problem.HasManifold(block)) {
+      *why = "a parameter block has a manifold";
+      return false;
+    }
+    for (int i = 0; i < problem.ParameterBlockSize(block); ++i) {
+      if (problem.GetParameterLowerBound(block, i) >
+              -std::numeric_limits<double>::max() ||
+          problem.GetParameterUpperBound(block, i) <
+              std::numeric_limits<double>::max()) {
+        *why = "a parameter is bounded (a self-calibration)";
+        return false;
+      }
+    }
+  }
+  const BandedProblem banded(problem, order);
+  const std::vector<int> first = banded.EnvelopeFirst();
+  *size = BandedSize();
+  for (int i = 0; i < static_cast<int>(first.size()); ++i) {
+    size->entries += i - first[i] + 1;
+    // EnvelopeMatrix::Factorize's inner products of row i.
+    for (int j = first[i]; j <= i; ++j) {
+      size->multiply_adds += j - std::max(first[i], first[j]);
+    }
+  }
+  return true;
+}
+
+void MinimizeBanded(const ceres::Solver::Options& options,
+                    const std::vector<double*>& order, ceres::Problem* problem,
+                    ceres::Solver::Summary* summary) {
+  const double start = Now();
+  *summary = ceres::Solver::Summary();
+  summary->minimizer_type = ceres::TRUST_REGION;
+  summary->trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
+  summary->num_parameter_blocks = problem->NumParameterBlocks();
+  summary->num_parameters = problem->NumParameters();
+  summary->num_residual_blocks = problem->NumResidualBlocks();
+  summary->num_residuals = problem->NumResiduals();
+  summary->num_threads_given = options.num_threads;
+  summary->num_threads_used = 1;
+  summary->num_successful_steps = summary->num_unsuccessful_steps = 0;
+
+  BandedProblem banded(*problem, order);
+  const int n = banded.num_columns();
+  summary->num_parameter_blocks_reduced = summary->num_parameter_blocks;
+  summary->num_parameters_reduced = n;
+  EnvelopeMatrix hessian(banded.EnvelopeFirst());
+  EnvelopeMatrix system(banded.EnvelopeFirst());
+  Eigen::VectorXd x = banded.Gather(), best = x, gradient(n);
+  double cost = 0.0;
+  auto finish = [&](ceres::TerminationType type, const std::string& message) {
+    summary->termination_type = type;
+    summary->message = message;
+    banded.Scatter(best);
+    summary->minimizer_time_in_seconds = Now() - start;
+    summary->total_time_in_seconds = summary->minimizer_time_in_seconds;
+  };
+  if (!banded.Linearize(x, &cost, &gradient, &hessian)) {
+    summary->initial_cost = std::numeric_limits<double>::quiet_NaN();
+    summary->final_cost = summary->initial_cost;
+    finish(ceres::FAILURE, "Residual and Jacobian evaluation failed.");
+    return;
+  }
+  // Jacobi scaling from the first Jacobian, kept for the whole solve.
+  Eigen::VectorXd scale(n);
+  for (int i = 0; i < n; ++i) scale[i] = 1.0 / (1.0 + std::sqrt(hessian(i, i)));
+  summary->initial_cost = cost;
+  double minimum_cost = std::numeric_limits<double>::infinity();
+  // As Ceres: no parameter tolerance test before the first accepted step
+  // (its x_norm_ starts at -1).
+  double x_norm = -1.0;
+  double radius = options.initial_trust_region_radius;
+  double decrease_factor = 2.0;
+  int invalid_steps = 0;
+  ceres::IterationSummary it;
+  it.step_is_valid = it.step_is_successful = true;
+  it.eta = options.eta;
+  it.cost = cost;
+  it.gradient_max_norm = gradient.lpNorm<Eigen::Infinity>();
+  it.gradient_norm = gradient.norm();
+  double iteration_start = start;
+  for (;;) {
+    // Ceres's FinalizeIterationAndCheckIfMinimizerCanContinue.
+    if (it.step_is_successful) {
+      ++summary->num_successful_steps;
+      it.step_is_nonmonotonic = !(cost < minimum_cost);
+      if (cost < minimum_cost) {
+        minimum_cost = cost;
+        best = x;
+      }
+    } else {
+      ++summary->num_unsuccessful_steps;
+    }
+    it.trust_region_radius = radius;
+    it.iteration_time_in_seconds = Now() - iteration_start;
+    it.cumulative_time_in_seconds = Now() - start;
+    summary->iterations.push_back(it);
+    summary->final_cost = minimum_cost;
+    if (options.update_state_every_iteration) banded.Scatter(x);
+    for (ceres::IterationCallback* callback : options.callbacks) {
+      const ceres::CallbackReturnType answer = (*callback)(it);
+      if (answer == ceres::SOLVER_ABORT) {
+        return finish(ceres::USER_FAILURE,
+                      "User callback returned SOLVER_ABORT.");
+      }
+      if (answer == ceres::SOLVER_TERMINATE_SUCCESSFULLY) {
+        return finish(ceres::USER_SUCCESS,
+                      "User callback returned SOLVER_TERMINATE_SUCCESSFULLY.");
+      }
+    }
+    if (Now() - start >= options.max_solver_time_in_seconds) {
+      return finish(ceres::NO_CONVERGENCE,
+                    Format("Maximum solver time reached. Total solver time: "
+                           "%e >= %e.",
+                           Now() - start, options.max_solver_time_in_seconds));
+    }
+    if (it.iteration >= options.max_num_iterations) {
+      return finish(ceres::NO_CONVERGENCE,
+                    "Maximum number of iterations reached. Number of "
+                    "iterations: " +
+                        std::to_string(it.iteration) + ".");
+    }
+    if (it.step_is_successful &&
+        it.gradient_max_norm <= options.gradient_tolerance) {
+      return finish(ceres::CONVERGENCE,
+                    Format("Gradient tolerance reached. Gradient max norm: "
+                           "%e <= %e",
+                           it.gradient_max_norm, options.gradient_tolerance));
+    }
+    if (radius <= options.min_trust_region_radius) {
+      return finish(ceres::CONVERGENCE,
+                    Format("Minimum trust region radius reached. Trust region "
+                           "radius: %e <= %e",
+                           radius, options.min_trust_region_radius));
+    }
+
+    iteration_start = Now();
+    ceres::IterationSummary next;
+    next.iteration = it.iteration + 1;
+    next.eta = options.eta;
+    // The LM step in Jacobi-scaled columns z = x / scale (Ceres's
+    // LevenbergMarquardtStrategy): (S H S + diag(clamped S H S) / radius) z
+    // = -S g.
+    for (int i = 0; i < n; ++i) {
+      const double* h = hessian.row(i);
+      double* a = system.row(i);
+      const int f = hessian.first(i);
+      for (int j = f; j <= i; ++j) a[j - f] = h[j - f] * scale[i] * scale[j];
+      a[i - f] += std::clamp(a[i - f], options.min_lm_diagonal,
+                             options.max_lm_diagonal) /
+                  radius;
+    }
+    const double solve_start = Now();
+    Eigen::VectorXd step;
+    double model_cost_change = 0.0;
+    bool valid = system.Factorize();
+    if (valid) {
+      step = scale.cwiseProduct(system.Solve(-scale.cwiseProduct(gradient)));
+      model_cost_change =
+          -(gradient.dot(step) + 0.5 * step.dot(hessian.Multiply(step)));
+      valid = step.allFinite() && model_cost_change > 0.0;
+    }
+    next.step_solver_time_in_seconds = Now() - solve_start;
+    if (!valid) {
+      if (++invalid_steps >= options.max_num_consecutive_invalid_steps) {
+        return finish(
+            ceres::FAILURE,
+            "Number of consecutive invalid steps more than "
+            "Solver::Options::max_num_consecutive_invalid_steps: " +
+                std::to_string(options.max_num_consecutive_invalid_steps));
+      }
+      radius /= decrease_factor;
+      decrease_factor *= 2.0;
+      next.cost = cost;
+      next.gradient_max_norm = it.gradient_max_norm;
+      next.gradient_norm = it.gradient_norm;
+      it = next;
+      continue;
+    }
+    invalid_steps = 0;
+    next.step_is_valid = true;
+    const Eigen::VectorXd candidate = x + step;
+    double candidate_cost;
+    if (!banded.Cost(candidate, &candidate_cost)) {
+      candidate_cost = std::numeric_limits<double>::max();
+    }
+    next.step_norm = step.norm();
+    if (next.step_norm <=
+        options.parameter_tolerance * (x_norm + options.parameter_tolerance)) {
+      return finish(
+          ceres::CONVERGENCE,
+          Format("Parameter tolerance reached. Relative step_norm: "
+                 "%e <= %e.",
+                 next.step_norm / (x_norm + options.parameter_tolerance),
+                 options.parameter_tolerance));
+    }
+    next.cost_change = cost - candidate_cost;
+    if (std::abs(next.cost_change) <= options.function_tolerance * cost) {
+      return finish(ceres::CONVERGENCE,
+                    Format("Function tolerance reached. |cost_change|/cost: "
+                           "%e <= %e",
+                           std::abs(next.cost_change) / cost,
+                           options.function_tolerance));
+    }
+    next.relative_decrease = next.cost_change / model_cost_change;
+    if (next.relative_decrease > options.min_relative_decrease) {
+      x = candidate;
+      x_norm = x.norm();
+      if (!banded.Linearize(x, &cost, &gradient, &hessian)) {
+        return finish(ceres::FAILURE,
+                      "Residual and Jacobian evaluation failed.");
+      }
+      next.step_is_successful = true;
+      next.cost = cost;
+      next.gradient_max_norm = gradient.lpNorm<Eigen::Infinity>();
+      next.gradient_norm = gradient.norm();
+      radius = std::min(
+          options.max_trust_region_radius,
+          radius /
+              std::max(1.0 / 3.0,
+                       1.0 - std::pow(2.0 * next.relative_decrease - 1.0, 3)));
+      decrease_factor = 2.0;
+    } else {
+      next.cost = candidate_cost;
+      next.gradient_max_norm = it.gradient_max_norm;
+      next.gradient_norm = it.gradient_norm;
+      radius /= decrease_factor;
+      decrease_factor *= 2.0;
+    }
+    it = next;
+  }
+}
+
+}  // namespace rff

@@ -1,0 +1,50 @@
+// Levenberg-Marquardt over a ceres::Problem whose normal equations are
+// factorised as an EnvelopeMatrix: the BANDED_CHOLESKY linear solver.
+// Ceres 2.1 takes no linear solver of one's own, so this is Ceres's
+// trust-region loop restated (TrustRegionMinimizer with the
+// LevenbergMarquardtStrategy and Jacobi scaling: the same steps, radius
+// updates and stopping rules, read from the same ceres::Solver::Options)
+// around one factorisation that exploits a time-ordered system. The
+// residual blocks, cost functions and losses are the problem's own.
+#ifndef RFF_CERES_BANDED_MINIMIZER_H_
+#define RFF_CERES_BANDED_MINIMIZER_H_
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "ceres/problem.h"
+#include "ceres/solver.h"
+
+namespace rff {
+
+// The name --linear_solver takes for it.
+inline constexpr char kBandedCholesky[] = "BANDED_CHOLESKY";
+
+// The envelope of H in a column order: the doubles it stores and the
+// multiply-adds of one factorisation.
+struct BandedSize {
+  std::int64_t entries = 0;
+  double multiply_adds = 0.0;
+};
+
+// Whether `problem` can be solved with its parameter blocks in `order` (every
+// block of the problem once): no manifolds or bounds (this loop does not
+// project); then its envelope's size in `*size`. Otherwise false with the
+// cause in `why`.
+bool BandedSolvable(const ceres::Problem& problem,
+                    const std::vector<double*>& order, BandedSize* size,
+                    std::string* why);
+
+// Minimises `problem` from its current values and writes the best values
+// back, filling `summary` as ceres::Solve would (iterations, costs,
+// termination, message, times). `order` as for BandedSolvable, which must
+// have accepted it. Honours the options' tolerances, trust region settings,
+// iteration and time limits, callbacks and update_state_every_iteration.
+void MinimizeBanded(const ceres::Solver::Options& options,
+                    const std::vector<double*>& order, ceres::Problem* problem,
+                    ceres::Solver::Summary* summary);
+
+}  // namespace rff
+
+#endif  // RFF_CERES_BANDED_MINIMIZER_H_

@@ -1,0 +1,54 @@
+// A symmetric positive definite matrix stored by its lower envelope: row i
+// keeps columns first(i)..i. The Cholesky factor L (A = L L^T) has no entry
+// outside the envelope (George & Liu 1981, ch. 4), so a system whose columns
+// are ordered in time (trajectory states, then the few blocks every row
+// touches: landmarks, calibrations) factorises in O(n b^2 + m n b) for a
+// band b and m full rows, where a general sparse Cholesky pays for its
+// symbolic machinery on every column.
+#ifndef RFF_CERES_ENVELOPE_CHOLESKY_H_
+#define RFF_CERES_ENVELOPE_CHOLESKY_H_
+
+#include <cstdint>
+#include <vector>
+
+#include "Eigen/Core"
+
+namespace rff {
+
+class EnvelopeMatrix {
+ public:
+  // `first[i]` <= i is the first stored column of row i.
+  explicit EnvelopeMatrix(std::vector<int> first);
+
+  int size() const { return static_cast<int>(first_.size()); }
+  int first(int i) const { return first_[i]; }
+  // Stored entries: the doubles the factorisation needs.
+  std::int64_t num_entries() const { return start_.back(); }
+  void SetZero();
+  // Entry (i, j), j in first(i)..i.
+  double& operator()(int i, int j) {
+    return values_[start_[i] + j - first_[i]];
+  }
+  double operator()(int i, int j) const {
+    return values_[start_[i] + j - first_[i]];
+  }
+  double* row(int i) { return values_.data() + start_[i]; }
+  const double* row(int i) const { return values_.data() + start_[i]; }
+
+  // y = A x, the symmetric matrix the envelope holds (before Factorize).
+  Eigen::VectorXd Multiply(const Eigen::VectorXd& x) const;
+  // Replaces the matrix by its Cholesky factor L; false (matrix left
+  // partly overwritten) when a pivot is not positive and finite.
+  bool Factorize();
+  // A^-1 b with the factor of Factorize.
+  Eigen::VectorXd Solve(const Eigen::VectorXd& b) const;
+
+ private:
+  std::vector<int> first_;
+  std::vector<std::int64_t> start_;  // Row i's entries at start_[i].
+  std::vector<double> values_;
+};
+
+}  // namespace rff
+
+#endif  // RFF_CERES_ENVELOPE_CHOLESKY_H_

@@ -1,0 +1,211 @@
+#include "rff_ceres/banded_minimizer.h"
+
+#include <cmath>
+#include <memory>
+#include <vector>
+
+#include "ceres/autodiff_cost_function.h"
+#include "ceres/ceres.h"
+#include "gtest/gtest.h"
+
+namespace rff {
+namespace {
+
+// r = (p_{k+1} - 2 p_k + p_{k-1}) / sigma: a smooth chain of 2D points.
+struct SecondDifference {
+  template <typename T>
+  bool operator()(const T* a, const T* b, const T* c, T* r) const {
+    for (int i = 0; i < 2; ++i) r[i] = (a[i] - 2.0 * b[i] + c[i]) / 0.1;
+    return true;
+  }
+};
+
+// r = (|p - l| - range) / sigma: nonlinear in both blocks.
+struct Range {
+  double range;
+  template <typename T>
+  bool operator()(const T* p, const T* l, T* r) const {
+    const T dx = p[0] - l[0], dy = p[1] - l[1];
+    r[0] = (sqrt(dx * dx + dy * dy) - range) / 0.05;
+    return true;
+  }
+};
+
+// r = (p - mean) / sigma.
+struct Prior {
+  double x, y, sigma;
+  template <typename T>
+  bool operator()(const T* p, T* r) const {
+    r[0] = (p[0] - x) / sigma;
+    r[1] = (p[1] - y) / sigma;
+    return true;
+  }
+};
+
+// A time-ordered problem: `n` points on a curve, ranges to 3 landmarks
+// from every point (every 7th `outlier` m off, under `loss`), priors on the
+// first point and the landmarks; started away from the truth.
+struct ChainProblem {
+  std::vector<Eigen::Vector2d> points, landmarks;
+  std::unique_ptr<ceres::Problem> problem;
+
+  ChainProblem(int n, ceres::LossFunction* loss, double outlier = 0.0) {
+    ceres::Problem::Options options;
+    options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+    problem = std::make_unique<ceres::Problem>(options);
+    const std::vector<Eigen::Vector2d> truth_landmarks = {
+        {0.0, 5.0}, {8.0, -3.0}, {4.0, 9.0}};
+    points.resize(n);
+    landmarks = truth_landmarks;
+    for (Eigen::Vector2d& l : landmarks) l += Eigen::Vector2d(0.4, -0.3);
+    for (int k = 0; k < n; ++k) {
+      const double t = 0.1 * k;
+      const Eigen::Vector2d truth(t, std::sin(t));
+      points[k] = truth + Eigen::Vector2d(0.3 * std::cos(3.0 * t), 0.2);
+      for (int j = 0; j < 3; ++j) {
+        const double range = (truth - truth_landmarks[j]).norm() +
+                             (k % 7 == 3 ? outlier : 0.01 * std::sin(k + j));
+        problem->AddResidualBlock(
+            new ceres::AutoDiffCostFunction<Range, 1, 2, 2>(new Range{range}),
+            loss, points[k].data(), landmarks[j].data());
+      }
+    }
+    for (int k = 1; k + 1 < n; ++k) {
+      problem->AddResidualBlock(
+          new ceres::AutoDiffCostFunction<SecondDifference, 2, 2, 2, 2>(
+              new SecondDifference),
+          nullptr, points[k + 1].data(), points[k].data(),
+          points[k - 1].data());
+    }
+    problem->AddResidualBlock(
+        new ceres::AutoDiffCostFunction<Prior, 2, 2>(new Prior{0.0, 0.0, 0.01}),
+        nullptr, points[0].data());
+    for (int j = 0; j < 3; ++j) {
+      problem->AddResidualBlock(
+          new ceres::AutoDiffCostFunction<Prior, 2, 2>(
+              new Prior{truth_landmarks[j].x(), truth_landmarks[j].y(), 1.0}),
+          nullptr, landmarks[j].data());
+    }
+  }
+
+  std::vector<double*> Order() {
+    std::vector<double*> order;
+    for (Eigen::Vector2d& p : points) order.push_back(p.data());
+    for (Eigen::Vector2d& l : landmarks) order.push_back(l.data());
+    return order;
+  }
+
+  Eigen::VectorXd Values() const {
+    Eigen::VectorXd v(2 * (points.size() + landmarks.size()));
+    int i = 0;
+    for (const auto* set : {&points, &landmarks}) {
+      for (const Eigen::Vector2d& p : *set) v.segment<2>(2 * i++) = p;
+    }
+    return v;
+  }
+};
+
+ceres::Solver::Options SparseCholesky() {
+  ceres::Solver::Options options;
+  options.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
+  options.max_num_iterations = 100;
+  options.function_tolerance = 1e-10;
+  return options;
+}
+
+// Ceres's own trust-region loop and the banded one take the same steps.
+void ExpectSameAsCeres(ceres::LossFunction* loss, double outlier) {
+  ChainProblem ceres_side(80, loss, outlier), banded_side(80, loss, outlier);
+  ceres::Solver::Summary expected, actual;
+  ceres::Solve(SparseCholesky(), ceres_side.problem.get(), &expected);
+  BandedSize size;
+  std::string why;
+  ASSERT_TRUE(
+      BandedSolvable(*banded_side.problem, banded_side.Order(), &size, &why))
+      << why;
+  MinimizeBanded(SparseCholesky(), banded_side.Order(),
+                 banded_side.problem.get(), &actual);
+  ASSERT_EQ(expected.termination_type, ceres::CONVERGENCE) << expected.message;
+  EXPECT_EQ(actual.termination_type, expected.termination_type);
+  EXPECT_EQ(actual.iterations.size(), expected.iterations.size());
+  EXPECT_EQ(actual.num_successful_steps, expected.num_successful_steps);
+  EXPECT_NEAR(actual.initial_cost, expected.initial_cost,
+              1e-12 * expected.initial_cost);
+  EXPECT_NEAR(actual.final_cost, expected.final_cost,
+              1e-9 * expected.final_cost);
+  const Eigen::VectorXd a = banded_side.Values(), e = ceres_side.Values();
+  EXPECT_LT((a - e).lpNorm<Eigen::Infinity>(), 1e-9);
+  // The solve moved far from the start: the comparison is not vacuous.
+  EXPECT_GT(
+      (e - ChainProblem(80, loss, outlier).Values()).lpNorm<Eigen::Infinity>(),
+      0.2);
+}
+
+TEST(BandedMinimizerTest, MatchesCeresWithoutALoss) {
+  ExpectSameAsCeres(nullptr, 0.0);
+}
+
+TEST(BandedMinimizerTest, MatchesCeresWithCauchysClampedCorrection) {
+  ceres::CauchyLoss loss(1.0);
+  ExpectSameAsCeres(&loss, 2.0);
+}
+
+// TolerantLoss has rho'' > 0: the full second-order (Triggs) correction.
+TEST(BandedMinimizerTest, MatchesCeresWithTheFullCorrection) {
+  ceres::TolerantLoss loss(4.0, 1.0);
+  ExpectSameAsCeres(&loss, 0.0);
+}
+
+TEST(BandedMinimizerTest, StopsAtTheIterationCapAndOnACallback) {
+  ChainProblem chain(40, nullptr);
+  ceres::Solver::Options options = SparseCholesky();
+  options.max_num_iterations = 2;
+  ceres::Solver::Summary summary;
+  MinimizeBanded(options, chain.Order(), chain.problem.get(), &summary);
+  EXPECT_EQ(summary.termination_type, ceres::NO_CONVERGENCE);
+  EXPECT_EQ(summary.message,
+            "Maximum number of iterations reached. Number of iterations: 2.");
+  EXPECT_EQ(summary.iterations.size(), 3u);
+
+  struct Abort : ceres::IterationCallback {
+    ceres::CallbackReturnType operator()(
+        const ceres::IterationSummary& s) override {
+      return s.iteration == 1 ? ceres::SOLVER_ABORT : ceres::SOLVER_CONTINUE;
+    }
+  } abort;
+  options = SparseCholesky();
+  options.callbacks.push_back(&abort);
+  MinimizeBanded(options, chain.Order(), chain.problem.get(), &summary);
+  EXPECT_EQ(summary.termination_type, ceres::USER_FAILURE);
+  EXPECT_EQ(summary.message, "User callback returned SOLVER_ABORT.");
+  EXPECT_EQ(summary.iterations.size(), 2u);
+}
+
+TEST(BandedMinimizerTest, RefusesBoundsAndAnIncompleteOrder) {
+  ChainProblem chain(10, nullptr);
+  BandedSize size;
+  std::string why;
+  std::vector<double*> order = chain.Order();
+  order.pop_back();
+  EXPECT_FALSE(BandedSolvable(*chain.problem, order, &size, &why));
+  EXPECT_EQ(why, "the column order does not hold every parameter block");
+  chain.problem->SetParameterLowerBound(chain.points[3].data(), 0, -1.0);
+  EXPECT_FALSE(BandedSolvable(*chain.problem, chain.Order(), &size, &why));
+  EXPECT_EQ(why, "a parameter is bounded (a self-calibration)");
+}
+
+TEST(BandedMinimizerTest, SizesTheEnvelopeOfABandWithABorder) {
+  ChainProblem chain(10, nullptr);
+  BandedSize size;
+  std::string why;
+  ASSERT_TRUE(BandedSolvable(*chain.problem, chain.Order(), &size, &why));
+  // Point k's rows reach back to point k - 2 (the second differences): row
+  // i stores min(i, 4 + i % 2) + 1 columns. Landmarks: full rows.
+  std::int64_t expected = 0;
+  for (int i = 0; i < 20; ++i) expected += std::min(i, 4 + i % 2) + 1;
+  for (int i = 20; i < 26; ++i) expected += i + 1;
+  EXPECT_EQ(size.entries, expected);
+}
+
+}  // namespace
+}  // namespace rff

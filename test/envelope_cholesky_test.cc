@@ -1,0 +1,87 @@
+#include "rff_ceres/envelope_cholesky.h"
+
+#include <limits>
+#include <random>
+
+#include "Eigen/Cholesky"
+#include "gtest/gtest.h"
+
+namespace rff {
+namespace {
+
+// A banded SPD matrix with `border` full rows and columns last, the shape
+// of a time-ordered SLAM system with landmarks.
+Eigen::MatrixXd BandedWithBorder(int band_size, int bandwidth, int border,
+                                 std::vector<int>* first) {
+  const int n = band_size + border;
+  std::mt19937 random(7);
+  std::normal_distribution<double> normal;
+  Eigen::MatrixXd j = Eigen::MatrixXd::Zero(3 * n, n);
+  for (int r = 0; r < 3 * n; ++r) {
+    const int c = r % band_size;
+    for (int k = c; k < std::min(band_size, c + bandwidth + 1); ++k) {
+      j(r, k) = normal(random);
+    }
+    if (border > 0) j(r, band_size + r % border) = normal(random);
+  }
+  const Eigen::MatrixXd a = j.transpose() * j;
+  first->assign(n, 0);
+  for (int i = 0; i < n; ++i) {
+    int f = 0;
+    while (a(i, f) == 0.0) ++f;  // The diagonal is positive.
+    (*first)[i] = f;
+  }
+  return a;
+}
+
+EnvelopeMatrix FromDense(const Eigen::MatrixXd& a,
+                         const std::vector<int>& first) {
+  EnvelopeMatrix e(first);
+  for (int i = 0; i < e.size(); ++i) {
+    for (int j = first[i]; j <= i; ++j) e(i, j) = a(i, j);
+  }
+  return e;
+}
+
+TEST(EnvelopeCholeskyTest, SolvesAsDenseCholeskyWithABorder) {
+  std::vector<int> first;
+  const Eigen::MatrixXd a = BandedWithBorder(60, 4, 3, &first);
+  EnvelopeMatrix e = FromDense(a, first);
+  EXPECT_LT(e.num_entries(), a.size() / 2);  // The envelope, not the square.
+  const Eigen::VectorXd x = Eigen::VectorXd::LinSpaced(a.rows(), -1.0, 2.0);
+  EXPECT_LT((e.Multiply(x) - a * x).norm(), 1e-12 * (a * x).norm());
+  const Eigen::VectorXd b = a * x;
+  ASSERT_TRUE(e.Factorize());
+  const Eigen::VectorXd expected = a.llt().solve(b);
+  EXPECT_LT((e.Solve(b) - expected).norm(), 1e-10 * expected.norm());
+  EXPECT_LT((e.Solve(b) - x).norm(), 1e-9 * x.norm());
+}
+
+TEST(EnvelopeCholeskyTest, FactorMatchesEigensLowerFactor) {
+  std::vector<int> first;
+  const Eigen::MatrixXd a = BandedWithBorder(30, 2, 0, &first);
+  EnvelopeMatrix e = FromDense(a, first);
+  ASSERT_TRUE(e.Factorize());
+  const Eigen::MatrixXd l = a.llt().matrixL();
+  for (int i = 0; i < e.size(); ++i) {
+    for (int j = 0; j <= i; ++j) {
+      // No fill outside the envelope.
+      const double entry = j >= first[i] ? e(i, j) : 0.0;
+      EXPECT_NEAR(entry, l(i, j), 1e-12 * l.norm()) << i << ", " << j;
+    }
+  }
+}
+
+TEST(EnvelopeCholeskyTest, RefusesAnIndefiniteOrNonFiniteMatrix) {
+  EnvelopeMatrix indefinite({0, 0});
+  indefinite(0, 0) = 1.0;
+  indefinite(1, 0) = 2.0;
+  indefinite(1, 1) = 1.0;  // Eigenvalues 3 and -1.
+  EXPECT_FALSE(indefinite.Factorize());
+  EnvelopeMatrix not_finite({0});
+  not_finite(0, 0) = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_FALSE(not_finite.Factorize());
+}
+
+}  // namespace
+}  // namespace rff
