@@ -162,11 +162,14 @@ DEFINE_double(max_memory_gb, 0.0,
               "a solver whose system is larger is refused before the solve, "
               "naming the size.");
 DEFINE_string(linear_solver, "auto",
-              "Ceres linear solver: auto (DENSE_SCHUR when at most 2000 "
+              "Linear solver: auto (DENSE_SCHUR when at most 2000 "
               "trajectory parameters remain after eliminating the landmarks, "
-              "else SPARSE_NORMAL_CHOLESKY), DENSE_SCHUR, SPARSE_SCHUR, "
-              "ITERATIVE_SCHUR, DENSE_QR, DENSE_NORMAL_CHOLESKY, "
-              "SPARSE_NORMAL_CHOLESKY or CGNR.");
+              "else BANDED_CHOLESKY where its factorisation is cheap and "
+              "nothing is bounded, else SPARSE_NORMAL_CHOLESKY), "
+              "BANDED_CHOLESKY (our Levenberg-Marquardt on a Cholesky of the "
+              "time-ordered system, no bounds), or a Ceres solver: "
+              "DENSE_SCHUR, SPARSE_SCHUR, ITERATIVE_SCHUR, DENSE_QR, "
+              "DENSE_NORMAL_CHOLESKY, SPARSE_NORMAL_CHOLESKY or CGNR.");
 DEFINE_string(preconditioner, "auto",
               "Ceres preconditioner of ITERATIVE_SCHUR and CGNR (the direct "
               "solvers use none and leave it unused): IDENTITY, JACOBI, "

@@ -121,8 +121,8 @@ const AppCase kAppCases[] = {
      "{dir}/out.tum"},
     {"SlamUnknownLinearSolver", SLAM "--linear_solver=MAGIC" SLAM_OUT,
      "rff_slam: error: --linear_solver=MAGIC: unknown linear solver; allowed "
-     "auto, DENSE_SCHUR, SPARSE_SCHUR, ITERATIVE_SCHUR, DENSE_QR, "
-     "DENSE_NORMAL_CHOLESKY, SPARSE_NORMAL_CHOLESKY or CGNR\n",
+     "auto, BANDED_CHOLESKY, DENSE_SCHUR, SPARSE_SCHUR, ITERATIVE_SCHUR, "
+     "DENSE_QR, DENSE_NORMAL_CHOLESKY, SPARSE_NORMAL_CHOLESKY or CGNR\n",
      "{dir}/out.tum"},
     {"SlamUnknownPreconditioner",
      SLAM "--linear_solver=ITERATIVE_SCHUR --preconditioner=MAGIC" SLAM_OUT,
