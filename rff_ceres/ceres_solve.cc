@@ -205,11 +205,8 @@ bool RunSolve(const SolverOptions& solver, ceres::Solver::Options ceres_options,
                            "auto or a Ceres linear solver");
       return false;
     }
-    const std::string cannot =
+    result->linear_solver_reason +=
         " (not " + std::string(kBandedCholesky) + ": " + why + ")";
-    if (result->linear_solver_reason.find(cannot) == std::string::npos) {
-      result->linear_solver_reason += cannot;
-    }
   }
   // Ceres's preprocessor edits the ordering it is given: a fresh one per solve.
   SetOrdering(problem, &ceres_options);

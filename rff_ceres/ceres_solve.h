@@ -56,7 +56,8 @@ void SetOrdering(SlamProblem* problem, ceres::Solver::Options* options);
 // Solves `problem` from its current values into result->summary with the
 // linear solver settled by ChooseLinearSolver: BANDED_CHOLESKY where asked,
 // or where "auto" settled on the sparse Cholesky and the problem has no
-// bounds (the choice and why then recorded in `result`); otherwise Ceres,
+// bounds and a cheap factorisation (the choice and why then recorded in
+// `result`, after ChooseLinearSolver's, once per call); otherwise Ceres,
 // once the system is known to fit in memory. False with the cause in
 // `error` when it does not fit or the solve fails (CheckSolve).
 bool RunSolve(const SolverOptions& solver, ceres::Solver::Options ceres_options,

@@ -137,6 +137,8 @@ bool IncrementalSolver::SolveUpdate(double now, int num_measurements,
   update.t = std::min(now, data_end_);
   update.num_measurements = num_measurements;
   update.active_blocks = SetActiveBlocks(now);
+  // Settled afresh: RunSolve records its own choice for this update.
+  ChooseLinearSolver(options_.solver, *model_, &ceres_options_, result_);
   if (!RunSolve(options_.solver, ceres_options_, slam_, result_, error)) {
     *error = "update at t = " + FormatNumber(update.t) + ": " + *error;
     return false;
