@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <limits>
 #include <map>
+#include <set>
 
 #include "ceres/cost_function.h"
 #include "ceres/loss_function.h"
@@ -30,6 +31,42 @@ struct ResidualTerm {
   std::vector<int> column;
   std::vector<int> size;
 };
+
+// The blocks of `columns` in column order: each placed block after the last
+// timed block one of its residuals touches.
+std::vector<double*> ColumnOrder(const ceres::Problem& problem,
+                                 const BandedColumns& columns) {
+  std::map<const double*, int> time_index, anchor;
+  for (std::size_t k = 0; k < columns.timed.size(); ++k) {
+    time_index[columns.timed[k]] = static_cast<int>(k);
+  }
+  for (const double* block : columns.placed) anchor[block] = -1;
+  std::vector<ceres::ResidualBlockId> ids;
+  problem.GetResidualBlocks(&ids);
+  std::vector<double*> blocks;
+  for (const ceres::ResidualBlockId id : ids) {
+    problem.GetParameterBlocksForResidualBlock(id, &blocks);
+    int latest = -1;
+    for (const double* block : blocks) {
+      const auto it = time_index.find(block);
+      if (it != time_index.end()) latest = std::max(latest, it->second);
+    }
+    for (const double* block : blocks) {
+      const auto it = anchor.find(block);
+      if (it != anchor.end()) it->second = std::max(it->second, latest);
+    }
+  }
+  std::vector<std::vector<double*>> after(columns.timed.size() + 1);
+  for (double* block : columns.placed)
+    after[anchor[block] + 1].push_back(block);
+  std::vector<double*> order = after[0];
+  for (std::size_t k = 0; k < columns.timed.size(); ++k) {
+    order.push_back(columns.timed[k]);
+    order.insert(order.end(), after[k + 1].begin(), after[k + 1].end());
+  }
+  order.insert(order.end(), columns.last.begin(), columns.last.end());
+  return order;
+}
 
 // The problem's residuals over the variable blocks laid out in `order`.
 class BandedProblem {
@@ -226,16 +263,21 @@ std::string Format(const char* format, double a, double b) {
 
 }  // namespace
 
-bool BandedSolvable(const ceres::Problem& problem,
-                    const std::vector<double*>& order, BandedSize* size,
-                    std::string* why) {
-  if (static_cast<int>(order.size()) != problem.NumParameterBlocks()) {
-    *why = "the column order does not hold every parameter block";
+bool BandedSolvable(const ceres::Problem& problem, const BandedColumns& columns,
+                    BandedSize* size, std::string* why) {
+  std::set<const double*> blocks;
+  for (const auto* set : {&columns.timed, &columns.placed, &columns.last}) {
+    blocks.insert(set->begin(), set->end());
+  }
+  if (static_cast<int>(blocks.size()) != problem.NumParameterBlocks() ||
+      blocks.size() !=
+          columns.timed.size() + columns.placed.size() + columns.last.size()) {
+    *why = "the columns do not hold every parameter block once";
     return false;
   }
-  for (const double* block : order) {
+  for (const double* block : blocks) {
     if (!problem.HasParameterBlock(block)) {
-      *why = "the column order holds a block the problem does not";
+      *why = "the columns hold a block the problem does not";
       return false;
     }
     if (problem.HasManifold(block)) {
@@ -252,7 +294,7 @@ bool BandedSolvable(const ceres::Problem& problem,
       }
     }
   }
-  const BandedProblem banded(problem, order);
+  const BandedProblem banded(problem, ColumnOrder(problem, columns));
   const std::vector<int> first = banded.EnvelopeFirst();
   *size = BandedSize();
   for (int i = 0; i < static_cast<int>(first.size()); ++i) {
@@ -266,7 +308,7 @@ bool BandedSolvable(const ceres::Problem& problem,
 }
 
 void MinimizeBanded(const ceres::Solver::Options& options,
-                    const std::vector<double*>& order, ceres::Problem* problem,
+                    const BandedColumns& columns, ceres::Problem* problem,
                     ceres::Solver::Summary* summary) {
   const double start = Now();
   *summary = ceres::Solver::Summary();
@@ -280,7 +322,7 @@ void MinimizeBanded(const ceres::Solver::Options& options,
   summary->num_threads_used = 1;
   summary->num_successful_steps = summary->num_unsuccessful_steps = 0;
 
-  BandedProblem banded(*problem, order);
+  BandedProblem banded(*problem, ColumnOrder(*problem, columns));
   const int n = banded.num_columns();
   summary->num_parameter_blocks_reduced = summary->num_parameter_blocks;
   summary->num_parameters_reduced = n;

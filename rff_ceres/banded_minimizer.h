@@ -28,21 +28,30 @@ struct BandedSize {
   double multiply_adds = 0.0;
 };
 
-// Whether `problem` can be solved with its parameter blocks in `order` (every
-// block of the problem once): no manifolds or bounds (this loop does not
-// project); then its envelope's size in `*size`. Otherwise false with the
-// cause in `why`.
-bool BandedSolvable(const ceres::Problem& problem,
-                    const std::vector<double*>& order, BandedSize* size,
-                    std::string* why);
+// The columns of the system: the `timed` blocks in time order; each `placed`
+// block right after the last timed block a residual couples it to (a
+// landmark's row then spans its sightings, not the run); the `last` blocks
+// after all (those rows from the whole run touch: calibrations, shared
+// blocks).
+struct BandedColumns {
+  std::vector<double*> timed, placed, last;
+};
+
+// Whether `problem` can be solved with its parameter blocks laid out as
+// `columns` (every block of the problem once): no manifolds or bounds (this
+// loop does not project); then its envelope's size in `*size`. Otherwise
+// false with the cause in `why`.
+bool BandedSolvable(const ceres::Problem& problem, const BandedColumns& columns,
+                    BandedSize* size, std::string* why);
 
 // Minimises `problem` from its current values and writes the best values
 // back, filling `summary` as ceres::Solve would (iterations, costs,
-// termination, message, times). `order` as for BandedSolvable, which must
-// have accepted it. Honours the options' tolerances, trust region settings,
-// iteration and time limits, callbacks and update_state_every_iteration.
+// termination, message, times). `columns` as for BandedSolvable, which
+// must have accepted them. Honours the options' tolerances, trust region
+// settings, iteration and time limits, callbacks and
+// update_state_every_iteration.
 void MinimizeBanded(const ceres::Solver::Options& options,
-                    const std::vector<double*>& order, ceres::Problem* problem,
+                    const BandedColumns& columns, ceres::Problem* problem,
                     ceres::Solver::Summary* summary);
 
 }  // namespace rff

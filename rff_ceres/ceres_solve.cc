@@ -168,11 +168,11 @@ bool RunSolve(const SolverOptions& solver, ceres::Solver::Options ceres_options,
        ceres_options.linear_solver_type == ceres::SPARSE_NORMAL_CHOLESKY &&
        ceres_options.trust_region_strategy_type ==
            ceres::LEVENBERG_MARQUARDT)) {
-    const std::vector<double*> order = problem->BandOrder();
+    const BandedColumns columns = problem->BandColumns();
     BandedSize size;
     std::string why;
     const int n = problem->problem()->NumParameters();
-    if (BandedSolvable(*problem->problem(), order, &size, &why)) {
+    if (BandedSolvable(*problem->problem(), columns, &size, &why)) {
       // The envelope twice: H and the factor of the damped system.
       const double bytes = 16.0 * static_cast<double>(size.entries);
       const double limit = MemoryLimitBytes(solver.max_memory_gb);
@@ -196,7 +196,7 @@ bool RunSolve(const SolverOptions& solver, ceres::Solver::Options ceres_options,
             "banded states: Levenberg-Marquardt on a Cholesky of the whole "
             "system in time order";
       }
-      MinimizeBanded(ceres_options, order, problem->problem(),
+      MinimizeBanded(ceres_options, columns, problem->problem(),
                      &result->summary);
       return CheckSolve(result->summary, problem, error);
     }

@@ -460,21 +460,22 @@ std::shared_ptr<ceres::ParameterBlockOrdering> SlamProblem::Ordering() {
   return ordering;
 }
 
-std::vector<double*> SlamProblem::BandOrder() {
-  std::vector<double*> order;
-  for (const bool shared : {false, true}) {
-    for (int b = 0; b < model_->num_blocks(); ++b) {
-      if (model_->IsSharedBlock(b) == shared) {
-        order.push_back(model_->mutable_block(b));
-      }
-    }
+BandedColumns SlamProblem::BandColumns() {
+  BandedColumns columns;
+  for (int b = 0; b < model_->num_blocks(); ++b) {
+    (model_->IsSharedBlock(b) ? columns.last : columns.timed)
+        .push_back(model_->mutable_block(b));
   }
   for (double* calibration :
        {range_calibration_.data(), odometry_calibration_.data()}) {
-    if (problem_->HasParameterBlock(calibration)) order.push_back(calibration);
+    if (problem_->HasParameterBlock(calibration)) {
+      columns.last.push_back(calibration);
+    }
   }
-  for (const LandmarkId id : added_) order.push_back(landmark_block(id));
-  return order;
+  for (const LandmarkId id : added_) {
+    columns.placed.push_back(landmark_block(id));
+  }
+  return columns;
 }
 
 }  // namespace rff

@@ -17,6 +17,7 @@
 #include "ceres/loss_function.h"
 #include "ceres/ordered_groups.h"
 #include "ceres/problem.h"
+#include "rff_ceres/banded_minimizer.h"
 #include "rff_ceres/odometry_preintegration.h"
 #include "rff_ceres/trajectory_model.h"
 #include "rff_ceres/types.h"
@@ -215,9 +216,9 @@ class SlamProblem {
   // finds its own independent set to eliminate.
   std::shared_ptr<ceres::ParameterBlockOrdering> Ordering();
   // Every parameter block in the columns of a time-ordered system: the
-  // trajectory blocks in the model's (time) order, then the shared blocks,
-  // the calibrations and the landmarks, which rows from the whole run touch.
-  std::vector<double*> BandOrder();
+  // trajectory blocks in the model's (time) order, the landmarks each placed
+  // after its sightings, the shared blocks and calibrations last.
+  BandedColumns BandColumns();
 
  private:
   // Parameter blocks of a cost over `maps` (model block ids rewritten to the

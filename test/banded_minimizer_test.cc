@@ -43,13 +43,15 @@ struct Prior {
 };
 
 // A time-ordered problem: `n` points on a curve, ranges to 3 landmarks
-// from every point (every 7th `outlier` m off, under `loss`), priors on the
+// from every point, or with `local` to landmark j from the j-th third of
+// the run only (every 7th `outlier` m off, under `loss`), priors on the
 // first point and the landmarks; started away from the truth.
 struct ChainProblem {
   std::vector<Eigen::Vector2d> points, landmarks;
   std::unique_ptr<ceres::Problem> problem;
 
-  ChainProblem(int n, ceres::LossFunction* loss, double outlier = 0.0) {
+  ChainProblem(int n, ceres::LossFunction* loss, double outlier = 0.0,
+               bool local = false) {
     ceres::Problem::Options options;
     options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
     problem = std::make_unique<ceres::Problem>(options);
@@ -63,6 +65,7 @@ struct ChainProblem {
       const Eigen::Vector2d truth(t, std::sin(t));
       points[k] = truth + Eigen::Vector2d(0.3 * std::cos(3.0 * t), 0.2);
       for (int j = 0; j < 3; ++j) {
+        if (local && (3 * k < j * n || 3 * k >= (j + 1) * n)) continue;
         const double range = (truth - truth_landmarks[j]).norm() +
                              (k % 7 == 3 ? outlier : 0.01 * std::sin(k + j));
         problem->AddResidualBlock(
@@ -88,11 +91,14 @@ struct ChainProblem {
     }
   }
 
-  std::vector<double*> Order() {
-    std::vector<double*> order;
-    for (Eigen::Vector2d& p : points) order.push_back(p.data());
-    for (Eigen::Vector2d& l : landmarks) order.push_back(l.data());
-    return order;
+  // Landmarks last, or each placed after its sightings.
+  BandedColumns Columns(bool place_landmarks = false) {
+    BandedColumns columns;
+    for (Eigen::Vector2d& p : points) columns.timed.push_back(p.data());
+    for (Eigen::Vector2d& l : landmarks) {
+      (place_landmarks ? columns.placed : columns.last).push_back(l.data());
+    }
+    return columns;
   }
 
   Eigen::VectorXd Values() const {
@@ -114,16 +120,18 @@ ceres::Solver::Options SparseCholesky() {
 }
 
 // Ceres's own trust-region loop and the banded one take the same steps.
-void ExpectSameAsCeres(ceres::LossFunction* loss, double outlier) {
-  ChainProblem ceres_side(80, loss, outlier), banded_side(80, loss, outlier);
+void ExpectSameAsCeres(ceres::LossFunction* loss, double outlier,
+                       bool local = false) {
+  ChainProblem ceres_side(80, loss, outlier, local),
+      banded_side(80, loss, outlier, local);
   ceres::Solver::Summary expected, actual;
   ceres::Solve(SparseCholesky(), ceres_side.problem.get(), &expected);
   BandedSize size;
   std::string why;
   ASSERT_TRUE(
-      BandedSolvable(*banded_side.problem, banded_side.Order(), &size, &why))
+      BandedSolvable(*banded_side.problem, banded_side.Columns(), &size, &why))
       << why;
-  MinimizeBanded(SparseCholesky(), banded_side.Order(),
+  MinimizeBanded(SparseCholesky(), banded_side.Columns(),
                  banded_side.problem.get(), &actual);
   ASSERT_EQ(expected.termination_type, ceres::CONVERGENCE) << expected.message;
   EXPECT_EQ(actual.termination_type, expected.termination_type);
@@ -156,12 +164,31 @@ TEST(BandedMinimizerTest, MatchesCeresWithTheFullCorrection) {
   ExpectSameAsCeres(&loss, 0.0);
 }
 
+// Landmarks seen from a third of the run each, placed after their
+// sightings: the same steps, and an envelope that no longer spans the run.
+TEST(BandedMinimizerTest, MatchesCeresWithLandmarksPlacedAfterTheirSightings) {
+  ExpectSameAsCeres(nullptr, 0.0, /*local=*/true);
+  ChainProblem chain(90, nullptr, 0.0, /*local=*/true);
+  BandedSize placed, last;
+  std::string why;
+  ASSERT_TRUE(
+      BandedSolvable(*chain.problem, chain.Columns(true), &placed, &why));
+  ASSERT_TRUE(
+      BandedSolvable(*chain.problem, chain.Columns(false), &last, &why));
+  // The points' rows: 1 + 2 + 3 + 4 + 88 * (5 + 6) = 978. Last, landmark
+  // j's rows reach back to its first sighting: 181 + 182, 123 + 124,
+  // 65 + 66. Placed, each spans its 30 points (61 + 62), and the two points
+  // after it reach back over it (8 more each, the last landmark has none).
+  EXPECT_EQ(last.entries, 978 + 741);
+  EXPECT_EQ(placed.entries, 978 + 3 * 123 + 2 * 8);
+}
+
 TEST(BandedMinimizerTest, StopsAtTheIterationCapAndOnACallback) {
   ChainProblem chain(40, nullptr);
   ceres::Solver::Options options = SparseCholesky();
   options.max_num_iterations = 2;
   ceres::Solver::Summary summary;
-  MinimizeBanded(options, chain.Order(), chain.problem.get(), &summary);
+  MinimizeBanded(options, chain.Columns(), chain.problem.get(), &summary);
   EXPECT_EQ(summary.termination_type, ceres::NO_CONVERGENCE);
   EXPECT_EQ(summary.message,
             "Maximum number of iterations reached. Number of iterations: 2.");
@@ -175,7 +202,7 @@ TEST(BandedMinimizerTest, StopsAtTheIterationCapAndOnACallback) {
   } abort;
   options = SparseCholesky();
   options.callbacks.push_back(&abort);
-  MinimizeBanded(options, chain.Order(), chain.problem.get(), &summary);
+  MinimizeBanded(options, chain.Columns(), chain.problem.get(), &summary);
   EXPECT_EQ(summary.termination_type, ceres::USER_FAILURE);
   EXPECT_EQ(summary.message, "User callback returned SOLVER_ABORT.");
   EXPECT_EQ(summary.iterations.size(), 2u);
@@ -185,12 +212,17 @@ TEST(BandedMinimizerTest, RefusesBoundsAndAnIncompleteOrder) {
   ChainProblem chain(10, nullptr);
   BandedSize size;
   std::string why;
-  std::vector<double*> order = chain.Order();
-  order.pop_back();
-  EXPECT_FALSE(BandedSolvable(*chain.problem, order, &size, &why));
-  EXPECT_EQ(why, "the column order does not hold every parameter block");
+  BandedColumns columns = chain.Columns();
+  columns.last.pop_back();
+  EXPECT_FALSE(BandedSolvable(*chain.problem, columns, &size, &why));
+  EXPECT_EQ(why, "the columns do not hold every parameter block once");
+  columns = chain.Columns();
+  columns.last.push_back(columns.timed[0]);
+  columns.last.erase(columns.last.begin());
+  EXPECT_FALSE(BandedSolvable(*chain.problem, columns, &size, &why));
+  EXPECT_EQ(why, "the columns do not hold every parameter block once");
   chain.problem->SetParameterLowerBound(chain.points[3].data(), 0, -1.0);
-  EXPECT_FALSE(BandedSolvable(*chain.problem, chain.Order(), &size, &why));
+  EXPECT_FALSE(BandedSolvable(*chain.problem, chain.Columns(), &size, &why));
   EXPECT_EQ(why, "a parameter is bounded (a self-calibration)");
 }
 
@@ -198,7 +230,7 @@ TEST(BandedMinimizerTest, SizesTheEnvelopeOfABandWithABorder) {
   ChainProblem chain(10, nullptr);
   BandedSize size;
   std::string why;
-  ASSERT_TRUE(BandedSolvable(*chain.problem, chain.Order(), &size, &why));
+  ASSERT_TRUE(BandedSolvable(*chain.problem, chain.Columns(), &size, &why));
   // Point k's rows reach back to point k - 2 (the second differences): row
   // i stores min(i, 4 + i % 2) + 1 columns. Landmarks: full rows.
   std::int64_t expected = 0;
