@@ -5,8 +5,8 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
-#include <map>
 #include <set>
+#include <unordered_map>
 
 #include "ceres/cost_function.h"
 #include "ceres/loss_function.h"
@@ -23,77 +23,61 @@ double Now() {
 }
 
 // One residual block: its cost, loss and parameter blocks, each with its
-// first column in the system (-1 for a constant block).
+// first column in the system (-1 for a constant block) and size; the
+// arrays are BandedProblem's, shared by all terms.
 struct ResidualTerm {
   const ceres::CostFunction* cost = nullptr;
   const ceres::LossFunction* loss = nullptr;
-  std::vector<double*> blocks;
-  std::vector<int> column;
-  std::vector<int> size;
+  int num_blocks = 0;
+  double* const* blocks = nullptr;
+  const int* column = nullptr;
+  const int* size = nullptr;
 };
 
-// The blocks of `columns` in column order: each placed block after the last
-// timed block one of its residuals touches.
-std::vector<double*> ColumnOrder(const ceres::Problem& problem,
-                                 const BandedColumns& columns) {
-  std::map<const double*, int> time_index, anchor;
-  for (std::size_t k = 0; k < columns.timed.size(); ++k) {
-    time_index[columns.timed[k]] = static_cast<int>(k);
-  }
-  for (const double* block : columns.placed) anchor[block] = -1;
-  std::vector<ceres::ResidualBlockId> ids;
-  problem.GetResidualBlocks(&ids);
-  std::vector<double*> blocks;
-  for (const ceres::ResidualBlockId id : ids) {
-    problem.GetParameterBlocksForResidualBlock(id, &blocks);
-    int latest = -1;
-    for (const double* block : blocks) {
-      const auto it = time_index.find(block);
-      if (it != time_index.end()) latest = std::max(latest, it->second);
-    }
-    for (const double* block : blocks) {
-      const auto it = anchor.find(block);
-      if (it != anchor.end()) it->second = std::max(it->second, latest);
-    }
-  }
-  std::vector<std::vector<double*>> after(columns.timed.size() + 1);
-  for (double* block : columns.placed)
-    after[anchor[block] + 1].push_back(block);
-  std::vector<double*> order = after[0];
-  for (std::size_t k = 0; k < columns.timed.size(); ++k) {
-    order.push_back(columns.timed[k]);
-    order.insert(order.end(), after[k + 1].begin(), after[k + 1].end());
-  }
-  order.insert(order.end(), columns.last.begin(), columns.last.end());
-  return order;
-}
-
-// The problem's residuals over the variable blocks laid out in `order`.
+// The problem's residuals over the variable blocks laid out as `columns`,
+// each placed block after the last timed block one of its residuals
+// touches.
 class BandedProblem {
  public:
-  BandedProblem(const ceres::Problem& problem,
-                const std::vector<double*>& order) {
-    std::map<const double*, int> column;
-    for (double* block : order) {
-      if (problem.IsParameterBlockConstant(block)) continue;
-      column[block] = num_columns_;
-      variables_.push_back(block);
-      variable_sizes_.push_back(problem.ParameterBlockSize(block));
-      num_columns_ += variable_sizes_.back();
-    }
+  BandedProblem(const ceres::Problem& problem, const BandedColumns& columns) {
     std::vector<ceres::ResidualBlockId> ids;
     problem.GetResidualBlocks(&ids);
+    std::vector<int> begin;
+    std::vector<double*> blocks;
     for (const ceres::ResidualBlockId id : ids) {
-      ResidualTerm term;
-      term.cost = problem.GetCostFunctionForResidualBlock(id);
-      term.loss = problem.GetLossFunctionForResidualBlock(id);
-      problem.GetParameterBlocksForResidualBlock(id, &term.blocks);
-      for (double* block : term.blocks) {
-        const auto it = column.find(block);
-        term.column.push_back(it == column.end() ? -1 : it->second);
-        term.size.push_back(problem.ParameterBlockSize(block));
+      problem.GetParameterBlocksForResidualBlock(id, &blocks);
+      begin.push_back(static_cast<int>(blocks_.size()));
+      blocks_.insert(blocks_.end(), blocks.begin(), blocks.end());
+    }
+    begin.push_back(static_cast<int>(blocks_.size()));
+    // Per block its first column (-1: constant) and size.
+    std::unordered_map<const double*, std::pair<int, int>> layout;
+    layout.reserve(problem.NumParameterBlocks());
+    for (double* block : ColumnOrder(columns, begin)) {
+      const int size = problem.ParameterBlockSize(block);
+      if (problem.IsParameterBlockConstant(block)) {
+        layout[block] = {-1, size};
+        continue;
       }
-      terms_.push_back(std::move(term));
+      layout[block] = {num_columns_, size};
+      variables_.push_back(block);
+      variable_sizes_.push_back(size);
+      num_columns_ += size;
+    }
+    for (double* block : blocks_) {
+      const std::pair<int, int>& place = layout.at(block);
+      columns_.push_back(place.first);
+      sizes_.push_back(place.second);
+    }
+    terms_.resize(ids.size());
+    for (std::size_t r = 0; r < ids.size(); ++r) {
+      ResidualTerm& term = terms_[r];
+      term.cost = problem.GetCostFunctionForResidualBlock(ids[r]);
+      term.loss = problem.GetLossFunctionForResidualBlock(ids[r]);
+      term.num_blocks = begin[r + 1] - begin[r];
+      term.blocks = blocks_.data() + begin[r];
+      term.column = columns_.data() + begin[r];
+      term.size = sizes_.data() + begin[r];
     }
   }
 
@@ -106,10 +90,10 @@ class BandedProblem {
     for (int i = 0; i < num_columns_; ++i) first[i] = i;
     for (const ResidualTerm& term : terms_) {
       int lowest = num_columns_;
-      for (const int c : term.column) {
-        if (c >= 0) lowest = std::min(lowest, c);
+      for (int a = 0; a < term.num_blocks; ++a) {
+        if (term.column[a] >= 0) lowest = std::min(lowest, term.column[a]);
       }
-      for (std::size_t a = 0; a < term.column.size(); ++a) {
+      for (int a = 0; a < term.num_blocks; ++a) {
         if (term.column[a] < 0) continue;
         for (int i = 0; i < term.size[a]; ++i) {
           first[term.column[a] + i] =
@@ -166,10 +150,45 @@ class BandedProblem {
   }
 
  private:
+  // The blocks of `columns` in column order, from the residuals' blocks
+  // (residual r's at blocks_[begin[r]] up to begin[r + 1]).
+  std::vector<double*> ColumnOrder(const BandedColumns& columns,
+                                   const std::vector<int>& begin) const {
+    std::unordered_map<const double*, int> time_index, anchor;
+    time_index.reserve(columns.timed.size());
+    anchor.reserve(columns.placed.size());
+    for (std::size_t k = 0; k < columns.timed.size(); ++k) {
+      time_index[columns.timed[k]] = static_cast<int>(k);
+    }
+    for (const double* block : columns.placed) anchor[block] = -1;
+    for (std::size_t r = 0; r + 1 < begin.size(); ++r) {
+      int latest = -1;
+      for (int e = begin[r]; e < begin[r + 1]; ++e) {
+        const auto it = time_index.find(blocks_[e]);
+        if (it != time_index.end()) latest = std::max(latest, it->second);
+      }
+      for (int e = begin[r]; e < begin[r + 1]; ++e) {
+        const auto it = anchor.find(blocks_[e]);
+        if (it != anchor.end()) it->second = std::max(it->second, latest);
+      }
+    }
+    std::vector<std::vector<double*>> after(columns.timed.size() + 1);
+    for (double* block : columns.placed) {
+      after[anchor[block] + 1].push_back(block);
+    }
+    std::vector<double*> order = after[0];
+    for (std::size_t k = 0; k < columns.timed.size(); ++k) {
+      order.push_back(columns.timed[k]);
+      order.insert(order.end(), after[k + 1].begin(), after[k + 1].end());
+    }
+    order.insert(order.end(), columns.last.begin(), columns.last.end());
+    return order;
+  }
+
   bool Evaluate(const ResidualTerm& term, const Eigen::VectorXd& x,
                 bool jacobians, double* cost) {
     const int rows = term.cost->num_residuals();
-    const std::size_t n = term.blocks.size();
+    const std::size_t n = term.num_blocks;
     parameters_.resize(n);
     jacobian_rows_.resize(n);
     jacobian_pointers_.resize(n);
@@ -219,7 +238,7 @@ class BandedProblem {
   void Accumulate(const ResidualTerm& term, Eigen::VectorXd* g,
                   EnvelopeMatrix* h) const {
     const int rows = static_cast<int>(residual_.size());
-    for (std::size_t a = 0; a < term.blocks.size(); ++a) {
+    for (int a = 0; a < term.num_blocks; ++a) {
       if (term.column[a] < 0) continue;
       const double* ja = jacobian_rows_[a].data();
       const int sa = term.size[a], ca = term.column[a];
@@ -227,7 +246,7 @@ class BandedProblem {
         for (int i = 0; i < sa; ++i)
           (*g)[ca + i] += ja[k * sa + i] * residual_[k];
       }
-      for (std::size_t b = 0; b < term.blocks.size(); ++b) {
+      for (int b = 0; b < term.num_blocks; ++b) {
         const int cb = term.column[b];
         if (cb < 0 || cb > ca) continue;
         const double* jb = jacobian_rows_[b].data();
@@ -247,6 +266,8 @@ class BandedProblem {
 
   std::vector<double*> variables_;  // In column order, with their sizes.
   std::vector<int> variable_sizes_;
+  std::vector<double*> blocks_;  // Every term's blocks, columns and sizes.
+  std::vector<int> columns_, sizes_;
   std::vector<ResidualTerm> terms_;
   int num_columns_ = 0;
   std::vector<const double*> parameters_;
@@ -294,7 +315,7 @@ bool BandedSolvable(const ceres::Problem& problem, const BandedColumns& columns,
       }
     }
   }
-  const BandedProblem banded(problem, ColumnOrder(problem, columns));
+  const BandedProblem banded(problem, columns);
   const std::vector<int> first = banded.EnvelopeFirst();
   *size = BandedSize();
   for (int i = 0; i < static_cast<int>(first.size()); ++i) {
@@ -322,7 +343,7 @@ void MinimizeBanded(const ceres::Solver::Options& options,
   summary->num_threads_used = 1;
   summary->num_successful_steps = summary->num_unsuccessful_steps = 0;
 
-  BandedProblem banded(*problem, ColumnOrder(*problem, columns));
+  BandedProblem banded(*problem, columns);
   const int n = banded.num_columns();
   summary->num_parameter_blocks_reduced = summary->num_parameter_blocks;
   summary->num_parameters_reduced = n;
