@@ -26,7 +26,8 @@ trap 'rm -rf "$work"' EXIT
     --output="$work/laser_10hz_s1.rffd" > /dev/null 2> "$work/simulate.err" ||
   fail "rff_simulate failed: $(cat "$work/simulate.err")"
 
-solvers=(auto SPARSE_NORMAL_CHOLESKY SPARSE_SCHUR ITERATIVE_SCHUR DENSE_SCHUR)
+solvers=(auto BANDED_CHOLESKY SPARSE_NORMAL_CHOLESKY SPARSE_SCHUR ITERATIVE_SCHUR
+  DENSE_SCHUR)
 header="| recording | prior |" rule="| --- | --- |"
 for solver in "${solvers[@]}"; do
   header="$header $solver |" rule="$rule --- |"
