@@ -7,6 +7,7 @@
 #include <limits>
 #include <set>
 #include <unordered_map>
+#include <unordered_set>
 
 #include "ceres/cost_function.h"
 #include "ceres/loss_function.h"
@@ -53,9 +54,12 @@ class BandedProblem {
     // Per block its first column (-1: constant) and size.
     std::unordered_map<const double*, std::pair<int, int>> layout;
     layout.reserve(problem.NumParameterBlocks());
+    // As Ceres's preprocessor: blocks no residual uses are no variables.
+    const std::unordered_set<const double*> used(blocks_.begin(),
+                                                 blocks_.end());
     for (double* block : ColumnOrder(columns, begin)) {
       const int size = problem.ParameterBlockSize(block);
-      if (problem.IsParameterBlockConstant(block)) {
+      if (problem.IsParameterBlockConstant(block) || used.count(block) == 0) {
         layout[block] = {-1, size};
         continue;
       }
@@ -69,19 +73,38 @@ class BandedProblem {
       columns_.push_back(place.first);
       sizes_.push_back(place.second);
     }
-    terms_.resize(ids.size());
     for (std::size_t r = 0; r < ids.size(); ++r) {
-      ResidualTerm& term = terms_[r];
+      ResidualTerm term;
       term.cost = problem.GetCostFunctionForResidualBlock(ids[r]);
       term.loss = problem.GetLossFunctionForResidualBlock(ids[r]);
       term.num_blocks = begin[r + 1] - begin[r];
       term.blocks = blocks_.data() + begin[r];
       term.column = columns_.data() + begin[r];
       term.size = sizes_.data() + begin[r];
+      const bool variable =
+          std::any_of(term.column, term.column + term.num_blocks,
+                      [](int c) { return c >= 0; });
+      // Terms of constant blocks only are Ceres's fixed cost: outside the
+      // tolerance tests and the step quality.
+      (variable ? terms_ : fixed_terms_).push_back(term);
     }
   }
 
+  // The cost of the terms no variable changes; false as Cost.
+  bool FixedCost(double* cost) {
+    *cost = 0.0;
+    for (const ResidualTerm& term : fixed_terms_) {
+      double term_cost;
+      if (!Evaluate(term, Eigen::VectorXd(), false, &term_cost)) return false;
+      *cost += term_cost;
+    }
+    return true;
+  }
+
   int num_columns() const { return num_columns_; }
+  int num_variable_blocks() const {
+    return static_cast<int>(variables_.size());
+  }
 
   // Row i of H = J^T J stores from the first column any residual couples
   // to column i.
@@ -268,7 +291,7 @@ class BandedProblem {
   std::vector<int> variable_sizes_;
   std::vector<double*> blocks_;  // Every term's blocks, columns and sizes.
   std::vector<int> columns_, sizes_;
-  std::vector<ResidualTerm> terms_;
+  std::vector<ResidualTerm> terms_, fixed_terms_;
   int num_columns_ = 0;
   std::vector<const double*> parameters_;
   std::vector<std::vector<double>> jacobian_rows_;
@@ -310,7 +333,10 @@ bool BandedSolvable(const ceres::Problem& problem, const BandedColumns& columns,
               -std::numeric_limits<double>::max() ||
           problem.GetParameterUpperBound(block, i) <
               std::numeric_limits<double>::max()) {
-        *why = "a parameter is bounded (a self-calibration)";
+        *why =
+            "a parameter has bounds (the self-calibrations of "
+            "--estimate_range_calibration and --estimate_odometry_calibration "
+            "have)";
         return false;
       }
     }
@@ -318,6 +344,7 @@ bool BandedSolvable(const ceres::Problem& problem, const BandedColumns& columns,
   const BandedProblem banded(problem, columns);
   const std::vector<int> first = banded.EnvelopeFirst();
   *size = BandedSize();
+  size->num_columns = banded.num_columns();
   for (int i = 0; i < static_cast<int>(first.size()); ++i) {
     size->entries += i - first[i] + 1;
     // EnvelopeMatrix::Factorize's inner products of row i.
@@ -331,6 +358,9 @@ bool BandedSolvable(const ceres::Problem& problem, const BandedColumns& columns,
 void MinimizeBanded(const ceres::Solver::Options& options,
                     const BandedColumns& columns, ceres::Problem* problem,
                     ceres::Solver::Summary* summary) {
+  CHECK(options.jacobi_scaling && !options.use_nonmonotonic_steps &&
+        !options.use_inner_iterations)
+      << "MinimizeBanded implements Ceres's default trust-region loop only";
   const double start = Now();
   *summary = ceres::Solver::Summary();
   summary->minimizer_type = ceres::TRUST_REGION;
@@ -345,29 +375,43 @@ void MinimizeBanded(const ceres::Solver::Options& options,
 
   BandedProblem banded(*problem, columns);
   const int n = banded.num_columns();
-  summary->num_parameter_blocks_reduced = summary->num_parameter_blocks;
   summary->num_parameters_reduced = n;
-  EnvelopeMatrix hessian(banded.EnvelopeFirst());
-  EnvelopeMatrix system(banded.EnvelopeFirst());
-  Eigen::VectorXd x = banded.Gather(), best = x, gradient(n);
-  double cost = 0.0;
+  summary->num_parameter_blocks_reduced = banded.num_variable_blocks();
+  const Eigen::VectorXd start_values = banded.Gather();
+  Eigen::VectorXd x = start_values, best = x, gradient(n);
+  // Costs without the fixed cost, which the reported ones include.
+  double cost = 0.0, fixed_cost = 0.0;
   auto finish = [&](ceres::TerminationType type, const std::string& message) {
     summary->termination_type = type;
     summary->message = message;
-    banded.Scatter(best);
+    // As Ceres: a failed solve leaves the starting values.
+    banded.Scatter(summary->IsSolutionUsable() ? best : start_values);
+    summary->final_cost = summary->initial_cost;
+    for (const ceres::IterationSummary& i : summary->iterations) {
+      summary->final_cost = std::min(summary->final_cost, i.cost);
+    }
     summary->minimizer_time_in_seconds = Now() - start;
     summary->total_time_in_seconds = summary->minimizer_time_in_seconds;
   };
+  if (!banded.FixedCost(&fixed_cost)) {
+    return finish(ceres::FAILURE, "Unable to evaluate the fixed cost.");
+  }
+  summary->fixed_cost = fixed_cost;
+  if (n == 0) {
+    summary->initial_cost = fixed_cost;
+    return finish(ceres::CONVERGENCE,
+                  "Function tolerance reached. No non-constant parameter "
+                  "blocks found.");
+  }
+  EnvelopeMatrix hessian(banded.EnvelopeFirst());
+  EnvelopeMatrix system(banded.EnvelopeFirst());
   if (!banded.Linearize(x, &cost, &gradient, &hessian)) {
-    summary->initial_cost = std::numeric_limits<double>::quiet_NaN();
-    summary->final_cost = summary->initial_cost;
-    finish(ceres::FAILURE, "Residual and Jacobian evaluation failed.");
-    return;
+    return finish(ceres::FAILURE, "Residual and Jacobian evaluation failed.");
   }
   // Jacobi scaling from the first Jacobian, kept for the whole solve.
   Eigen::VectorXd scale(n);
   for (int i = 0; i < n; ++i) scale[i] = 1.0 / (1.0 + std::sqrt(hessian(i, i)));
-  summary->initial_cost = cost;
+  summary->initial_cost = cost + fixed_cost;
   double minimum_cost = std::numeric_limits<double>::infinity();
   // As Ceres: no parameter tolerance test before the first accepted step
   // (its x_norm_ starts at -1).
@@ -378,7 +422,7 @@ void MinimizeBanded(const ceres::Solver::Options& options,
   ceres::IterationSummary it;
   it.step_is_valid = it.step_is_successful = true;
   it.eta = options.eta;
-  it.cost = cost;
+  it.cost = cost + fixed_cost;
   it.gradient_max_norm = gradient.lpNorm<Eigen::Infinity>();
   it.gradient_norm = gradient.norm();
   double iteration_start = start;
@@ -398,7 +442,6 @@ void MinimizeBanded(const ceres::Solver::Options& options,
     it.iteration_time_in_seconds = Now() - iteration_start;
     it.cumulative_time_in_seconds = Now() - start;
     summary->iterations.push_back(it);
-    summary->final_cost = minimum_cost;
     if (options.update_state_every_iteration) banded.Scatter(x);
     for (ceres::IterationCallback* callback : options.callbacks) {
       const ceres::CallbackReturnType answer = (*callback)(it);
@@ -474,7 +517,7 @@ void MinimizeBanded(const ceres::Solver::Options& options,
       }
       radius /= decrease_factor;
       decrease_factor *= 2.0;
-      next.cost = cost;
+      next.cost = cost + fixed_cost;
       next.gradient_max_norm = it.gradient_max_norm;
       next.gradient_norm = it.gradient_norm;
       it = next;
@@ -514,7 +557,7 @@ void MinimizeBanded(const ceres::Solver::Options& options,
                       "Residual and Jacobian evaluation failed.");
       }
       next.step_is_successful = true;
-      next.cost = cost;
+      next.cost = cost + fixed_cost;
       next.gradient_max_norm = gradient.lpNorm<Eigen::Infinity>();
       next.gradient_norm = gradient.norm();
       radius = std::min(
@@ -524,7 +567,7 @@ void MinimizeBanded(const ceres::Solver::Options& options,
                        1.0 - std::pow(2.0 * next.relative_decrease - 1.0, 3)));
       decrease_factor = 2.0;
     } else {
-      next.cost = candidate_cost;
+      next.cost = candidate_cost + fixed_cost;
       next.gradient_max_norm = it.gradient_max_norm;
       next.gradient_norm = it.gradient_norm;
       radius /= decrease_factor;

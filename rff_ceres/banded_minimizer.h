@@ -21,9 +21,10 @@ namespace rff {
 // The name --linear_solver takes for it.
 inline constexpr char kBandedCholesky[] = "BANDED_CHOLESKY";
 
-// The envelope of H in a column order: the doubles it stores and the
-// multiply-adds of one factorisation.
+// The envelope of H in a column order: its columns (the variables), the
+// doubles it stores and the multiply-adds of one factorisation.
 struct BandedSize {
+  int num_columns = 0;
   std::int64_t entries = 0;
   double multiply_adds = 0.0;
 };
@@ -45,11 +46,14 @@ bool BandedSolvable(const ceres::Problem& problem, const BandedColumns& columns,
                     BandedSize* size, std::string* why);
 
 // Minimises `problem` from its current values and writes the best values
-// back, filling `summary` as ceres::Solve would (iterations, costs,
-// termination, message, times). `columns` as for BandedSolvable, which
-// must have accepted them. Honours the options' tolerances, trust region
-// settings, iteration and time limits, callbacks and
-// update_state_every_iteration.
+// back (the starting ones if it fails), filling `summary` as ceres::Solve
+// would: iterations, costs with the fixed cost of residuals on constant
+// blocks only, termination, message, times. `columns` as for
+// BandedSolvable, which must have accepted them. Honours the options'
+// tolerances, trust region radii, LM diagonal bounds, iteration and time
+// limits, callbacks and update_state_every_iteration; it runs on one thread
+// with Ceres's defaults of Jacobi scaling, monotonic steps and no inner
+// iterations, which rff_slam never changes (checked).
 void MinimizeBanded(const ceres::Solver::Options& options,
                     const BandedColumns& columns, ceres::Problem* problem,
                     ceres::Solver::Summary* summary);

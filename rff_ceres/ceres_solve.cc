@@ -1,6 +1,9 @@
 #include "rff_ceres/ceres_solve.h"
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
+#include <cstdio>
 
 #include "ceres/types.h"
 #include "glog/logging.h"
@@ -17,6 +20,12 @@ namespace {
 // columns (32^2 / 2 multiply-adds).
 constexpr double kMaxBandedWorkPerParameter = 512.0;
 
+// Linear solver names are read as Ceres reads its own: in any case.
+bool IsBandedCholesky(std::string name) {
+  for (char& c : name) c = static_cast<char>(std::toupper(c));
+  return name == kBandedCholesky;
+}
+
 // The preconditioners a flag can choose (SUBSET cannot be set up from one).
 constexpr char kPreconditioners[] =
     "auto, IDENTITY, JACOBI, SCHUR_JACOBI, CLUSTER_JACOBI or "
@@ -30,7 +39,7 @@ bool ToCeresOptions(const SolverOptions& options,
   // sparse Cholesky, whose options are always valid.
   // BANDED_CHOLESKY is not Ceres's: its Ceres options are the sparse
   // Cholesky's, for the problems it does not take.
-  const bool banded = options.linear_solver == kBandedCholesky;
+  const bool banded = IsBandedCholesky(options.linear_solver);
   std::string name = options.linear_solver == "auto" || banded
                          ? "SPARSE_NORMAL_CHOLESKY"
                          : options.linear_solver;
@@ -162,7 +171,7 @@ void SetOrdering(SlamProblem* problem, ceres::Solver::Options* options) {
 
 bool RunSolve(const SolverOptions& solver, ceres::Solver::Options ceres_options,
               SlamProblem* problem, SlamResult* result, std::string* error) {
-  const bool asked = solver.linear_solver == kBandedCholesky;
+  const bool asked = IsBandedCholesky(solver.linear_solver);
   if (asked ||
       (solver.linear_solver == "auto" &&
        ceres_options.linear_solver_type == ceres::SPARSE_NORMAL_CHOLESKY &&
@@ -171,22 +180,26 @@ bool RunSolve(const SolverOptions& solver, ceres::Solver::Options ceres_options,
     const BandedColumns columns = problem->BandColumns();
     BandedSize size;
     std::string why;
-    const int n = problem->problem()->NumParameters();
     if (BandedSolvable(*problem->problem(), columns, &size, &why)) {
       // The envelope twice: H and the factor of the damped system.
       const double bytes = 16.0 * static_cast<double>(size.entries);
       const double limit = MemoryLimitBytes(solver.max_memory_gb);
+      const double work = size.multiply_adds / std::max(size.num_columns, 1);
+      char text[160];
       if (bytes > limit) {
-        why = "its envelope needs about " + FormatNumber(bytes / 1e9) +
-              " GB, more than the " + FormatNumber(limit / 1e9) +
-              " GB allowed by --max_memory_gb";
-      } else if (!asked &&
-                 size.multiply_adds > kMaxBandedWorkPerParameter * n) {
-        // Landmarks seen over the whole run fill their rows of the factor;
+        std::snprintf(text, sizeof(text),
+                      "needs about %.3g GB for its envelope, more than the "
+                      "%.3g GB allowed by --max_memory_gb",
+                      bytes / 1e9, limit / 1e9);
+        why = text;
+      } else if (!asked && work > kMaxBandedWorkPerParameter) {
+        // Landmarks seen over long stretches fill their rows of the factor;
         // a fill-reducing sparse Cholesky then does better.
-        why = std::to_string(std::llround(size.multiply_adds / n)) +
-              " multiply-adds per parameter in its factorisation, more than " +
-              FormatNumber(kMaxBandedWorkPerParameter);
+        std::snprintf(text, sizeof(text),
+                      "%.0f multiply-adds per variable in its factorisation, "
+                      "more than %.0f",
+                      work, kMaxBandedWorkPerParameter);
+        why = text;
       }
     }
     if (why.empty()) {
@@ -201,7 +214,7 @@ bool RunSolve(const SolverOptions& solver, ceres::Solver::Options ceres_options,
       return CheckSolve(result->summary, problem, error);
     }
     if (asked) {
-      *error = OptionError("linear_solver", kBandedCholesky, why,
+      *error = OptionError("linear_solver", solver.linear_solver, why,
                            "auto or a Ceres linear solver");
       return false;
     }

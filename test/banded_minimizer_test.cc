@@ -183,6 +183,64 @@ TEST(BandedMinimizerTest, MatchesCeresWithLandmarksPlacedAfterTheirSightings) {
   EXPECT_EQ(placed.entries, 978 + 3 * 123 + 2 * 8);
 }
 
+// Constant blocks, a residual on constant blocks only (cost 5e5, which
+// Ceres keeps out of its tolerance tests as the fixed cost) and a block in
+// no residual (Ceres drops it; in the parameter norm it would stop the
+// solve early): the same steps as Ceres.
+TEST(BandedMinimizerTest, MatchesCeresWithFixedCostAndAnUnusedBlock) {
+  auto build = [](ChainProblem* chain, Eigen::Vector2d* unused) {
+    for (int k = 0; k < 5; ++k) {
+      chain->problem->SetParameterBlockConstant(chain->points[k].data());
+    }
+    chain->problem->AddResidualBlock(
+        new ceres::AutoDiffCostFunction<Prior, 2, 2>(new Prior{1e3, 0.0, 1.0}),
+        nullptr, chain->points[0].data());
+    chain->problem->AddParameterBlock(unused->data(), 2);
+  };
+  ChainProblem ceres_side(60, nullptr), banded_side(60, nullptr);
+  Eigen::Vector2d ceres_unused(1e6, 1e6), banded_unused(1e6, 1e6);
+  build(&ceres_side, &ceres_unused);
+  build(&banded_side, &banded_unused);
+  ceres::Solver::Summary expected, actual;
+  ceres::Solver::Options options = SparseCholesky();
+  options.function_tolerance = 1e-8;
+  ceres::Solve(options, ceres_side.problem.get(), &expected);
+  BandedColumns columns = banded_side.Columns();
+  columns.last.push_back(banded_unused.data());
+  MinimizeBanded(options, columns, banded_side.problem.get(), &actual);
+  ASSERT_EQ(expected.termination_type, ceres::CONVERGENCE);
+  EXPECT_EQ(actual.termination_type, ceres::CONVERGENCE);
+  EXPECT_EQ(actual.iterations.size(), expected.iterations.size());
+  EXPECT_NEAR(actual.fixed_cost, expected.fixed_cost, 1e-9);
+  EXPECT_GT(actual.fixed_cost, 4e5);
+  EXPECT_NEAR(actual.final_cost, expected.final_cost,
+              1e-9 * expected.final_cost);
+  EXPECT_LT(
+      (banded_side.Values() - ceres_side.Values()).lpNorm<Eigen::Infinity>(),
+      1e-9);
+  EXPECT_EQ(banded_unused, Eigen::Vector2d(1e6, 1e6));
+}
+
+TEST(BandedMinimizerTest, NothingToSolveIsConvergedAtTheFixedCost) {
+  ChainProblem chain(5, nullptr);
+  for (Eigen::Vector2d& p : chain.points) {
+    chain.problem->SetParameterBlockConstant(p.data());
+  }
+  for (Eigen::Vector2d& l : chain.landmarks) {
+    chain.problem->SetParameterBlockConstant(l.data());
+  }
+  ceres::Solver::Summary expected, actual;
+  ceres::Solve(SparseCholesky(), chain.problem.get(), &expected);
+  MinimizeBanded(SparseCholesky(), chain.Columns(), chain.problem.get(),
+                 &actual);
+  EXPECT_EQ(actual.termination_type, ceres::CONVERGENCE);
+  EXPECT_EQ(actual.message, expected.message);
+  EXPECT_EQ(actual.iterations.size(), 0u);
+  EXPECT_NEAR(actual.final_cost, expected.final_cost,
+              1e-12 * expected.final_cost);
+  EXPECT_GT(actual.final_cost, 0.0);
+}
+
 TEST(BandedMinimizerTest, StopsAtTheIterationCapAndOnACallback) {
   ChainProblem chain(40, nullptr);
   ceres::Solver::Options options = SparseCholesky();
@@ -202,10 +260,13 @@ TEST(BandedMinimizerTest, StopsAtTheIterationCapAndOnACallback) {
   } abort;
   options = SparseCholesky();
   options.callbacks.push_back(&abort);
+  const Eigen::VectorXd start = chain.Values();
   MinimizeBanded(options, chain.Columns(), chain.problem.get(), &summary);
   EXPECT_EQ(summary.termination_type, ceres::USER_FAILURE);
   EXPECT_EQ(summary.message, "User callback returned SOLVER_ABORT.");
   EXPECT_EQ(summary.iterations.size(), 2u);
+  // A failed solve leaves the starting values, as Ceres does.
+  EXPECT_EQ(chain.Values(), start);
 }
 
 TEST(BandedMinimizerTest, RefusesBoundsAndAnIncompleteOrder) {
@@ -223,7 +284,10 @@ TEST(BandedMinimizerTest, RefusesBoundsAndAnIncompleteOrder) {
   EXPECT_EQ(why, "the columns do not hold every parameter block once");
   chain.problem->SetParameterLowerBound(chain.points[3].data(), 0, -1.0);
   EXPECT_FALSE(BandedSolvable(*chain.problem, chain.Columns(), &size, &why));
-  EXPECT_EQ(why, "a parameter is bounded (a self-calibration)");
+  EXPECT_EQ(why,
+            "a parameter has bounds (the self-calibrations of "
+            "--estimate_range_calibration and --estimate_odometry_calibration "
+            "have)");
 }
 
 TEST(BandedMinimizerTest, SizesTheEnvelopeOfABandWithABorder) {

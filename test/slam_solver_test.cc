@@ -114,9 +114,6 @@ TEST(SlamSolverTest, WnoaFollowsOdometryThroughAGapInTheObservations) {
   EXPECT_LT(std::sqrt(other_squares / other_count), 0.8);
 }
 
-// The answer does not depend on where the origin is: the same run 1e9 m
-// away (Ceres's parameter tolerance is relative to the parameters' size,
-// which stopped such a solve two iterations in, at 0.45 m instead of 0.22).
 // The banded Levenberg-Marquardt takes Ceres's steps on a WNOA problem: the
 // same iterations and the same answer to rounding (one round, learning off,
 // so that no decision amplifies the last bits).
@@ -154,6 +151,9 @@ TEST(SlamSolverTest, BandedCholeskyMatchesCeresSparseCholesky) {
   EXPECT_EQ(automatic.linear_solver, "BANDED_CHOLESKY");
 }
 
+// The answer does not depend on where the origin is: the same run 1e9 m
+// away (Ceres's parameter tolerance is relative to the parameters' size,
+// which stopped such a solve two iterations in, at 0.45 m instead of 0.22).
 TEST(SlamSolverTest, ShiftingTheSceneShiftsTheAnswer) {
   Dataset dataset;
   std::string error;
@@ -473,9 +473,10 @@ INSTANTIATE_TEST_SUITE_P(
                     o->solver.linear_solver = "BANDED_CHOLESKY";
                     o->problem.range_calibration.estimate = true;
                   },
-                  "--linear_solver=BANDED_CHOLESKY: a parameter is bounded "
-                  "(a self-calibration); allowed auto or a Ceres linear "
-                  "solver"},
+                  "--linear_solver=BANDED_CHOLESKY: a parameter has bounds "
+                  "(the self-calibrations of --estimate_range_calibration "
+                  "and --estimate_odometry_calibration have); allowed auto "
+                  "or a Ceres linear solver"},
         BadOption{"CgnrWithSchurPreconditioner",
                   [](SlamOptions* o) {
                     o->solver.linear_solver = "CGNR";
@@ -940,6 +941,20 @@ TEST(LinearSystemSizeTest, TooLargeDenseSystemIsRefusedAndAutoSolves) {
             "than the 1e-06 GB allowed by --max_memory_gb (fewer features or "
             "longer segments need less); allowed more than 0.000387 where the "
             "machine has it");
+  // The banded Cholesky's envelope above the limit: refused when asked for,
+  // before any iteration; auto says why it took the sparse one.
+  options.solver.linear_solver = "banded_cholesky";  // Any case, as Ceres's.
+  EXPECT_FALSE(RunSlam(dataset, options, &result, &error));
+  EXPECT_THAT(error,
+              StartsWith("--linear_solver=banded_cholesky: needs about "));
+  EXPECT_THAT(error, EndsWith(" GB for its envelope, more than the 1e-06 GB "
+                              "allowed by --max_memory_gb; allowed auto or a "
+                              "Ceres linear solver"));
+  EXPECT_EQ(result.total_iterations, 0);
+  options.solver.linear_solver = "auto";
+  options.solver.max_memory_gb = 0.001;
+  ASSERT_TRUE(RunSlam(dataset, options, &result, &error)) << error;
+  EXPECT_THAT(result.linear_solver_reason, HasSubstr("(not BANDED_CHOLESKY: "));
 }
 
 // 20k WNOA states, one landmark seen from every state: eliminating it fills
