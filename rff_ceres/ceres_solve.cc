@@ -16,9 +16,10 @@
 namespace rff {
 namespace {
 
-// Auto takes BANDED_CHOLESKY up to the work per parameter of a band of 32
-// columns (32^2 / 2 multiply-adds).
-constexpr double kMaxBandedWorkPerParameter = 512.0;
+// Auto takes BANDED_CHOLESKY up to this many multiply-adds per variable in
+// its factorisation. Measured against CHOLMOD in Ceres (bench/README.md):
+// faster at 220 (Plaza 1's WNOA), slower at 451 (MRCLAM robot 1).
+constexpr double kMaxBandedWorkPerVariable = 300.0;
 
 // Linear solver names are read as Ceres reads its own: in any case.
 bool IsBandedCholesky(std::string name) {
@@ -192,13 +193,13 @@ bool RunSolve(const SolverOptions& solver, ceres::Solver::Options ceres_options,
                       "%.3g GB allowed by --max_memory_gb",
                       bytes / 1e9, limit / 1e9);
         why = text;
-      } else if (!asked && work > kMaxBandedWorkPerParameter) {
+      } else if (!asked && work > kMaxBandedWorkPerVariable) {
         // Landmarks seen over long stretches fill their rows of the factor;
         // a fill-reducing sparse Cholesky then does better.
         std::snprintf(text, sizeof(text),
                       "%.0f multiply-adds per variable in its factorisation, "
                       "more than %.0f",
-                      work, kMaxBandedWorkPerParameter);
+                      work, kMaxBandedWorkPerVariable);
         why = text;
       }
     }

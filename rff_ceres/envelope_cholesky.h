@@ -1,10 +1,9 @@
 // A symmetric positive definite matrix stored by its lower envelope: row i
 // keeps columns first(i)..i. The Cholesky factor L (A = L L^T) has no entry
 // outside the envelope (George & Liu 1981, ch. 4), so a system whose columns
-// are ordered in time (trajectory states, then the few blocks every row
-// touches: landmarks, calibrations) factorises in O(n b^2 + m n b) for a
-// band b and m full rows, where a general sparse Cholesky pays for its
-// symbolic machinery on every column.
+// are ordered in time (trajectory states, each landmark after its
+// sightings, the calibrations last) factorises in O(n b^2 + m w b) for a
+// band b and m longer rows of width w, with no symbolic analysis.
 #ifndef RFF_CERES_ENVELOPE_CHOLESKY_H_
 #define RFF_CERES_ENVELOPE_CHOLESKY_H_
 
