@@ -222,13 +222,15 @@ class BandedProblem {
       jacobian_pointers_[a] =
           jacobians && term.column[a] >= 0 ? jacobian_rows_[a].data() : nullptr;
     }
-    residual_.resize(rows);
-    if (!term.cost->Evaluate(parameters_.data(), residual_.data(),
+    // A buffer that keeps its capacity: terms of other sizes alternate.
+    residual_buffer_.resize(rows);
+    Eigen::Map<Eigen::VectorXd> residual(residual_buffer_.data(), rows);
+    if (!term.cost->Evaluate(parameters_.data(), residual.data(),
                              jacobians ? jacobian_pointers_.data() : nullptr) ||
-        !residual_.allFinite()) {
+        !residual.allFinite()) {
       return false;
     }
-    const double squared_norm = residual_.squaredNorm();
+    const double squared_norm = residual.squaredNorm();
     double rho[3] = {squared_norm, 1.0, 0.0};
     if (term.loss != nullptr) term.loss->Evaluate(squared_norm, rho);
     *cost = 0.5 * rho[0];
@@ -248,26 +250,27 @@ class BandedProblem {
           j(jacobian_rows_[a].data(), rows, term.size[a]);
       if (!j.allFinite()) return false;
       if (alpha_over_norm != 0.0) {
-        const Eigen::RowVectorXd rj = residual_.transpose() * j;
-        j -= alpha_over_norm * residual_ * rj;
+        const Eigen::RowVectorXd rj = residual.transpose() * j;
+        j -= alpha_over_norm * residual * rj;
       }
       j *= sqrt_rho1;
     }
-    residual_ *= residual_scaling;
+    residual *= residual_scaling;
     return std::isfinite(*cost);
   }
 
   // g += J^T r and the lower triangle of H += J^T J, block pair by pair.
   void Accumulate(const ResidualTerm& term, Eigen::VectorXd* g,
                   EnvelopeMatrix* h) const {
-    const int rows = static_cast<int>(residual_.size());
+    const int rows = static_cast<int>(residual_buffer_.size());
+    const double* residual = residual_buffer_.data();
     for (int a = 0; a < term.num_blocks; ++a) {
       if (term.column[a] < 0) continue;
       const double* ja = jacobian_rows_[a].data();
       const int sa = term.size[a], ca = term.column[a];
       for (int k = 0; k < rows; ++k) {
         for (int i = 0; i < sa; ++i)
-          (*g)[ca + i] += ja[k * sa + i] * residual_[k];
+          (*g)[ca + i] += ja[k * sa + i] * residual[k];
       }
       for (int b = 0; b < term.num_blocks; ++b) {
         const int cb = term.column[b];
@@ -296,7 +299,7 @@ class BandedProblem {
   std::vector<const double*> parameters_;
   std::vector<std::vector<double>> jacobian_rows_;
   std::vector<double*> jacobian_pointers_;
-  Eigen::VectorXd residual_;
+  std::vector<double> residual_buffer_;  // The last term's residual.
 };
 
 std::string Format(const char* format, double a, double b) {
@@ -487,23 +490,28 @@ void MinimizeBanded(const ceres::Solver::Options& options,
     // The LM step in Jacobi-scaled columns z = x / scale (Ceres's
     // LevenbergMarquardtStrategy): (S H S + diag(clamped S H S) / radius) z
     // = -S g.
+    Eigen::VectorXd damping(n);  // D, the diagonal added to S H S.
     for (int i = 0; i < n; ++i) {
       const double* h = hessian.row(i);
       double* a = system.row(i);
       const int f = hessian.first(i);
       for (int j = f; j <= i; ++j) a[j - f] = h[j - f] * scale[i] * scale[j];
-      a[i - f] += std::clamp(a[i - f], options.min_lm_diagonal,
-                             options.max_lm_diagonal) /
-                  radius;
+      damping[i] = std::clamp(a[i - f], options.min_lm_diagonal,
+                              options.max_lm_diagonal) /
+                   radius;
+      a[i - f] += damping[i];
     }
     const double solve_start = Now();
     Eigen::VectorXd step;
     double model_cost_change = 0.0;
     bool valid = system.Factorize();
     if (valid) {
-      step = scale.cwiseProduct(system.Solve(-scale.cwiseProduct(gradient)));
+      const Eigen::VectorXd z = system.Solve(-scale.cwiseProduct(gradient));
+      step = scale.cwiseProduct(z);
+      // The Gauss-Newton model's decrease -(g^T dx + dx^T H dx / 2), with
+      // z^T S H S z = -g^T dx - z^T D z from the solve: no product with H.
       model_cost_change =
-          -(gradient.dot(step) + 0.5 * step.dot(hessian.Multiply(step)));
+          -0.5 * gradient.dot(step) + 0.5 * z.dot(damping.cwiseProduct(z));
       valid = step.allFinite() && model_cost_change > 0.0;
     }
     next.step_solver_time_in_seconds = Now() - solve_start;

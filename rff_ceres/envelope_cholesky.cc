@@ -21,20 +21,6 @@ void EnvelopeMatrix::SetZero() {
   std::fill(values_.begin(), values_.end(), 0.0);
 }
 
-Eigen::VectorXd EnvelopeMatrix::Multiply(const Eigen::VectorXd& x) const {
-  Eigen::VectorXd y = Eigen::VectorXd::Zero(size());
-  for (int i = 0; i < size(); ++i) {
-    const double* a = row(i);
-    const int f = first_[i];
-    for (int j = f; j < i; ++j) {
-      y[i] += a[j - f] * x[j];
-      y[j] += a[j - f] * x[i];
-    }
-    y[i] += a[i - f] * x[i];
-  }
-  return y;
-}
-
 // Row by row (the "bordering" form): L_ij = (A_ij - sum_k L_ik L_jk) / L_jj
 // over the columns k both rows store, then L_ii = sqrt(A_ii - sum_k L_ik^2).
 bool EnvelopeMatrix::Factorize() {

@@ -34,8 +34,6 @@ class EnvelopeMatrix {
   double* row(int i) { return values_.data() + start_[i]; }
   const double* row(int i) const { return values_.data() + start_[i]; }
 
-  // y = A x, the symmetric matrix the envelope holds (before Factorize).
-  Eigen::VectorXd Multiply(const Eigen::VectorXd& x) const;
   // Replaces the matrix by its Cholesky factor L; false (matrix left
   // partly overwritten) when a pivot is not positive and finite.
   bool Factorize();

@@ -49,7 +49,6 @@ TEST(EnvelopeCholeskyTest, SolvesAsDenseCholeskyWithABorder) {
   EnvelopeMatrix e = FromDense(a, first);
   EXPECT_LT(e.num_entries(), a.size() / 2);  // The envelope, not the square.
   const Eigen::VectorXd x = Eigen::VectorXd::LinSpaced(a.rows(), -1.0, 2.0);
-  EXPECT_LT((e.Multiply(x) - a * x).norm(), 1e-12 * (a * x).norm());
   const Eigen::VectorXd b = a * x;
   ASSERT_TRUE(e.Factorize());
   const Eigen::VectorXd expected = a.llt().solve(b);
