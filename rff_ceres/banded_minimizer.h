@@ -15,6 +15,7 @@
 
 #include "ceres/problem.h"
 #include "ceres/solver.h"
+#include "rff_ceres/banded_problem.h"
 
 namespace rff {
 
@@ -27,15 +28,6 @@ struct BandedSize {
   int num_columns = 0;
   std::int64_t entries = 0;
   double multiply_adds = 0.0;
-};
-
-// The columns of the system: the `timed` blocks in time order; each `placed`
-// block right after the last timed block a residual couples it to (a
-// landmark's row then spans its sightings, not the run); the `last` blocks
-// after all (those rows from the whole run touch: calibrations, shared
-// blocks).
-struct BandedColumns {
-  std::vector<double*> timed, placed, last;
 };
 
 // Whether `problem` can be solved with its parameter blocks laid out as

@@ -17,7 +17,7 @@
 #include "ceres/loss_function.h"
 #include "ceres/ordered_groups.h"
 #include "ceres/problem.h"
-#include "rff_ceres/banded_minimizer.h"
+#include "rff_ceres/banded_problem.h"
 #include "rff_ceres/odometry_preintegration.h"
 #include "rff_ceres/trajectory_model.h"
 #include "rff_ceres/types.h"

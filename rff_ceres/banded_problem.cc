@@ -1,0 +1,242 @@
+#include "rff_ceres/banded_problem.h"
+
+#include <algorithm>
+#include <cmath>
+#include <unordered_map>
+#include <unordered_set>
+#include <utility>
+
+namespace rff {
+
+BandedProblem::BandedProblem(const ceres::Problem& problem,
+                             const BandedColumns& columns) {
+  std::vector<ceres::ResidualBlockId> ids;
+  problem.GetResidualBlocks(&ids);
+  std::vector<int> begin;
+  std::vector<double*> blocks;
+  for (const ceres::ResidualBlockId id : ids) {
+    problem.GetParameterBlocksForResidualBlock(id, &blocks);
+    begin.push_back(static_cast<int>(blocks_.size()));
+    blocks_.insert(blocks_.end(), blocks.begin(), blocks.end());
+  }
+  begin.push_back(static_cast<int>(blocks_.size()));
+  // Per block its first column (-1: constant) and size.
+  std::unordered_map<const double*, std::pair<int, int>> layout;
+  layout.reserve(problem.NumParameterBlocks());
+  // As Ceres's preprocessor: blocks no residual uses are no variables.
+  const std::unordered_set<const double*> used(blocks_.begin(), blocks_.end());
+  for (double* block : ColumnOrder(columns, begin)) {
+    const int size = problem.ParameterBlockSize(block);
+    if (problem.IsParameterBlockConstant(block) || used.count(block) == 0) {
+      layout[block] = {-1, size};
+      continue;
+    }
+    layout[block] = {num_columns_, size};
+    variables_.push_back(block);
+    variable_sizes_.push_back(size);
+    num_columns_ += size;
+  }
+  for (double* block : blocks_) {
+    const std::pair<int, int>& place = layout.at(block);
+    columns_.push_back(place.first);
+    sizes_.push_back(place.second);
+  }
+  for (std::size_t r = 0; r < ids.size(); ++r) {
+    ResidualTerm term;
+    term.cost = problem.GetCostFunctionForResidualBlock(ids[r]);
+    term.loss = problem.GetLossFunctionForResidualBlock(ids[r]);
+    term.num_blocks = begin[r + 1] - begin[r];
+    term.blocks = blocks_.data() + begin[r];
+    term.column = columns_.data() + begin[r];
+    term.size = sizes_.data() + begin[r];
+    const bool variable =
+        std::any_of(term.column, term.column + term.num_blocks,
+                    [](int c) { return c >= 0; });
+    // Terms of constant blocks only are Ceres's fixed cost: outside the
+    // tolerance tests and the step quality.
+    (variable ? terms_ : fixed_terms_).push_back(term);
+  }
+}
+
+std::vector<int> BandedProblem::EnvelopeFirst() const {
+  std::vector<int> first(num_columns_);
+  for (int i = 0; i < num_columns_; ++i) first[i] = i;
+  for (const ResidualTerm& term : terms_) {
+    int lowest = num_columns_;
+    for (int a = 0; a < term.num_blocks; ++a) {
+      if (term.column[a] >= 0) lowest = std::min(lowest, term.column[a]);
+    }
+    for (int a = 0; a < term.num_blocks; ++a) {
+      if (term.column[a] < 0) continue;
+      for (int i = 0; i < term.size[a]; ++i) {
+        first[term.column[a] + i] = std::min(first[term.column[a] + i], lowest);
+      }
+    }
+  }
+  return first;
+}
+
+Eigen::VectorXd BandedProblem::Gather() const {
+  Eigen::VectorXd x(num_columns_);
+  int c = 0;
+  for (std::size_t b = 0; b < variables_.size(); ++b) {
+    for (int i = 0; i < variable_sizes_[b]; ++i) x[c++] = variables_[b][i];
+  }
+  return x;
+}
+
+void BandedProblem::Scatter(const Eigen::VectorXd& x) const {
+  int c = 0;
+  for (std::size_t b = 0; b < variables_.size(); ++b) {
+    for (int i = 0; i < variable_sizes_[b]; ++i) variables_[b][i] = x[c++];
+  }
+}
+
+bool BandedProblem::FixedCost(double* cost) {
+  *cost = 0.0;
+  for (const ResidualTerm& term : fixed_terms_) {
+    double term_cost;
+    if (!Evaluate(term, Eigen::VectorXd(), false, &term_cost)) return false;
+    *cost += term_cost;
+  }
+  return true;
+}
+
+bool BandedProblem::Cost(const Eigen::VectorXd& x, double* cost) {
+  *cost = 0.0;
+  for (const ResidualTerm& term : terms_) {
+    double term_cost;
+    if (!Evaluate(term, x, /*jacobians=*/false, &term_cost)) return false;
+    *cost += term_cost;
+  }
+  return true;
+}
+
+bool BandedProblem::Linearize(const Eigen::VectorXd& x, double* cost,
+                              Eigen::VectorXd* g, EnvelopeMatrix* h) {
+  *cost = 0.0;
+  g->setZero(num_columns_);
+  h->SetZero();
+  for (const ResidualTerm& term : terms_) {
+    double term_cost;
+    if (!Evaluate(term, x, /*jacobians=*/true, &term_cost)) return false;
+    *cost += term_cost;
+    Accumulate(term, g, h);
+  }
+  return true;
+}
+
+std::vector<double*> BandedProblem::ColumnOrder(
+    const BandedColumns& columns, const std::vector<int>& begin) const {
+  std::unordered_map<const double*, int> time_index, anchor;
+  time_index.reserve(columns.timed.size());
+  anchor.reserve(columns.placed.size());
+  for (std::size_t k = 0; k < columns.timed.size(); ++k) {
+    time_index[columns.timed[k]] = static_cast<int>(k);
+  }
+  for (const double* block : columns.placed) anchor[block] = -1;
+  for (std::size_t r = 0; r + 1 < begin.size(); ++r) {
+    int latest = -1;
+    for (int e = begin[r]; e < begin[r + 1]; ++e) {
+      const auto it = time_index.find(blocks_[e]);
+      if (it != time_index.end()) latest = std::max(latest, it->second);
+    }
+    for (int e = begin[r]; e < begin[r + 1]; ++e) {
+      const auto it = anchor.find(blocks_[e]);
+      if (it != anchor.end()) it->second = std::max(it->second, latest);
+    }
+  }
+  std::vector<std::vector<double*>> after(columns.timed.size() + 1);
+  for (double* block : columns.placed) {
+    after[anchor[block] + 1].push_back(block);
+  }
+  std::vector<double*> order = after[0];
+  for (std::size_t k = 0; k < columns.timed.size(); ++k) {
+    order.push_back(columns.timed[k]);
+    order.insert(order.end(), after[k + 1].begin(), after[k + 1].end());
+  }
+  order.insert(order.end(), columns.last.begin(), columns.last.end());
+  return order;
+}
+
+bool BandedProblem::Evaluate(const ResidualTerm& term, const Eigen::VectorXd& x,
+                             bool jacobians, double* cost) {
+  const int rows = term.cost->num_residuals();
+  const std::size_t n = term.num_blocks;
+  parameters_.resize(n);
+  jacobian_rows_.resize(n);
+  jacobian_pointers_.resize(n);
+  for (std::size_t a = 0; a < n; ++a) {
+    parameters_[a] =
+        term.column[a] >= 0 ? x.data() + term.column[a] : term.blocks[a];
+    jacobian_rows_[a].resize(static_cast<std::size_t>(rows) * term.size[a]);
+    jacobian_pointers_[a] =
+        jacobians && term.column[a] >= 0 ? jacobian_rows_[a].data() : nullptr;
+  }
+  // A buffer that keeps its capacity: terms of other sizes alternate.
+  residual_buffer_.resize(rows);
+  Eigen::Map<Eigen::VectorXd> residual(residual_buffer_.data(), rows);
+  if (!term.cost->Evaluate(parameters_.data(), residual.data(),
+                           jacobians ? jacobian_pointers_.data() : nullptr) ||
+      !residual.allFinite()) {
+    return false;
+  }
+  const double squared_norm = residual.squaredNorm();
+  double rho[3] = {squared_norm, 1.0, 0.0};
+  if (term.loss != nullptr) term.loss->Evaluate(squared_norm, rho);
+  *cost = 0.5 * rho[0];
+  if (!jacobians) return std::isfinite(*cost);
+  const double sqrt_rho1 = std::sqrt(rho[1]);
+  double residual_scaling = sqrt_rho1, alpha_over_norm = 0.0;
+  if (squared_norm > 0.0 && rho[2] > 0.0) {
+    const double alpha =
+        1.0 - std::sqrt(1.0 + 2.0 * squared_norm * rho[2] / rho[1]);
+    residual_scaling = sqrt_rho1 / (1.0 - alpha);
+    alpha_over_norm = alpha / squared_norm;
+  }
+  for (std::size_t a = 0; a < n; ++a) {
+    if (jacobian_pointers_[a] == nullptr) continue;
+    Eigen::Map<
+        Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>
+        j(jacobian_rows_[a].data(), rows, term.size[a]);
+    if (!j.allFinite()) return false;
+    if (alpha_over_norm != 0.0) {
+      const Eigen::RowVectorXd rj = residual.transpose() * j;
+      j -= alpha_over_norm * residual * rj;
+    }
+    j *= sqrt_rho1;
+  }
+  residual *= residual_scaling;
+  return std::isfinite(*cost);
+}
+
+void BandedProblem::Accumulate(const ResidualTerm& term, Eigen::VectorXd* g,
+                               EnvelopeMatrix* h) const {
+  const int rows = static_cast<int>(residual_buffer_.size());
+  const double* residual = residual_buffer_.data();
+  for (int a = 0; a < term.num_blocks; ++a) {
+    if (term.column[a] < 0) continue;
+    const double* ja = jacobian_rows_[a].data();
+    const int sa = term.size[a], ca = term.column[a];
+    for (int k = 0; k < rows; ++k) {
+      for (int i = 0; i < sa; ++i) (*g)[ca + i] += ja[k * sa + i] * residual[k];
+    }
+    for (int b = 0; b < term.num_blocks; ++b) {
+      const int cb = term.column[b];
+      if (cb < 0 || cb > ca) continue;
+      const double* jb = jacobian_rows_[b].data();
+      const int sb = term.size[b];
+      for (int i = 0; i < sa; ++i) {
+        double* hi = &(*h)(ca + i, cb);
+        const int width = a == b ? i + 1 : sb;
+        for (int k = 0; k < rows; ++k) {
+          const double v = ja[k * sa + i];
+          const double* jbk = jb + k * sb;
+          for (int j = 0; j < width; ++j) hi[j] += v * jbk[j];
+        }
+      }
+    }
+  }
+}
+
+}  // namespace rff

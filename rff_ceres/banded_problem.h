@@ -1,0 +1,97 @@
+// The normal equations of a ceres::Problem laid out for EnvelopeMatrix: the
+// problem's own residual blocks, cost functions and losses evaluated at a
+// state vector, with H = J^T J accumulated in a time-ordered envelope. The
+// model side of BANDED_CHOLESKY (banded_minimizer.h runs the loop).
+#ifndef RFF_CERES_BANDED_PROBLEM_H_
+#define RFF_CERES_BANDED_PROBLEM_H_
+
+#include <vector>
+
+#include "Eigen/Core"
+#include "ceres/cost_function.h"
+#include "ceres/loss_function.h"
+#include "ceres/problem.h"
+#include "rff_ceres/envelope_cholesky.h"
+
+namespace rff {
+
+// The columns of the system: the `timed` blocks in time order; each `placed`
+// block right after the last timed block a residual couples it to (a
+// landmark's row then spans its sightings, not the run); the `last` blocks
+// after all (those rows from the whole run touch: calibrations, shared
+// blocks).
+struct BandedColumns {
+  std::vector<double*> timed, placed, last;
+};
+
+// One residual block: its cost, loss and parameter blocks, each with its
+// first column in the system (-1 for a constant block) and size; the
+// arrays are BandedProblem's, shared by all terms.
+struct ResidualTerm {
+  const ceres::CostFunction* cost = nullptr;
+  const ceres::LossFunction* loss = nullptr;
+  int num_blocks = 0;
+  double* const* blocks = nullptr;
+  const int* column = nullptr;
+  const int* size = nullptr;
+};
+
+class BandedProblem {
+ public:
+  // The variables are the blocks of `columns` that are not constant and
+  // that a residual uses (as Ceres's preprocessor keeps them), in column
+  // order; residuals on constant blocks only are the fixed cost.
+  BandedProblem(const ceres::Problem& problem, const BandedColumns& columns);
+
+  int num_columns() const { return num_columns_; }
+  int num_variable_blocks() const {
+    return static_cast<int>(variables_.size());
+  }
+  // Row i of H = J^T J stores from the first column any residual couples
+  // to column i.
+  std::vector<int> EnvelopeFirst() const;
+
+  // The variables' values as a state vector, and back.
+  Eigen::VectorXd Gather() const;
+  void Scatter(const Eigen::VectorXd& x) const;
+
+  // The cost of the terms no variable changes; false as Cost.
+  bool FixedCost(double* cost);
+  // The cost at x; false where a residual is not finite or a cost
+  // function fails.
+  bool Cost(const Eigen::VectorXd& x, double* cost);
+  // The cost, gradient g = J^T r and H = J^T J at x, with each robust
+  // loss's correction of the residual and Jacobian (Triggs et al. 2000,
+  // 4.3, clamped as Ceres's Corrector clamps it where rho'' <= 0).
+  bool Linearize(const Eigen::VectorXd& x, double* cost, Eigen::VectorXd* g,
+                 EnvelopeMatrix* h);
+
+ private:
+  // The blocks of `columns` in column order, from the residuals' blocks
+  // (residual r's at blocks_[begin[r]] up to begin[r + 1]).
+  std::vector<double*> ColumnOrder(const BandedColumns& columns,
+                                   const std::vector<int>& begin) const;
+  // One term's cost at x and, with `jacobians`, its corrected residual and
+  // Jacobian blocks in the buffers below.
+  bool Evaluate(const ResidualTerm& term, const Eigen::VectorXd& x,
+                bool jacobians, double* cost);
+  // g += J^T r and the lower triangle of H += J^T J, block pair by pair,
+  // from the last Evaluate.
+  void Accumulate(const ResidualTerm& term, Eigen::VectorXd* g,
+                  EnvelopeMatrix* h) const;
+
+  std::vector<double*> variables_;  // In column order, with their sizes.
+  std::vector<int> variable_sizes_;
+  std::vector<double*> blocks_;  // Every term's blocks, columns and sizes.
+  std::vector<int> columns_, sizes_;
+  std::vector<ResidualTerm> terms_, fixed_terms_;
+  int num_columns_ = 0;
+  std::vector<const double*> parameters_;
+  std::vector<std::vector<double>> jacobian_rows_;
+  std::vector<double*> jacobian_pointers_;
+  std::vector<double> residual_buffer_;  // The last term's residual.
+};
+
+}  // namespace rff
+
+#endif  // RFF_CERES_BANDED_PROBLEM_H_
