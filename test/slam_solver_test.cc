@@ -602,6 +602,43 @@ TEST(SlamSolverTest, IncrementalModeTracksTheBatchSolution) {
   EXPECT_LT(ApeTranslation(dataset, incremental), 0.8) << "batch " << batch_ape;
 }
 
+// Incremental WNOA updates with frozen states (residuals on constant
+// blocks only are the fixed cost, out of the tolerance tests): the banded
+// solver takes Ceres's steps update by update.
+TEST(SlamSolverTest, IncrementalBandedCholeskyMatchesCeres) {
+  SimulationOptions sim = PaperOptions(14);
+  sim.num_steps = 120;
+  Dataset dataset;
+  std::string error;
+  ASSERT_TRUE(Simulate(sim, &dataset, &error)) << error;
+  SlamOptions options;
+  options.prior = "wnoa";
+  options.learn_hyperparameters = "off";
+  options.incremental.every = 40;
+  options.incremental.lag = 15.0;
+  SlamResult banded, ceres_side;
+  options.solver.linear_solver = "BANDED_CHOLESKY";
+  ASSERT_TRUE(RunSlam(dataset, options, &banded, &error)) << error;
+  options.solver.linear_solver = "SPARSE_NORMAL_CHOLESKY";
+  ASSERT_TRUE(RunSlam(dataset, options, &ceres_side, &error)) << error;
+  ASSERT_EQ(banded.updates.size(), ceres_side.updates.size());
+  ASSERT_GT(banded.updates.size(), 5u);
+  for (std::size_t u = 0; u < banded.updates.size(); ++u) {
+    EXPECT_EQ(banded.updates[u].iterations, ceres_side.updates[u].iterations)
+        << "update " << u;
+  }
+  // The 15 s lag keeps 17 of the 120 states variable at the end.
+  EXPECT_LT(banded.updates.back().active_blocks, 30);
+  ASSERT_EQ(banded.trajectory.size(), ceres_side.trajectory.size());
+  double largest = 0.0;
+  for (std::size_t i = 0; i < banded.trajectory.size(); ++i) {
+    largest = std::max(
+        {largest, std::abs(banded.trajectory[i].x - ceres_side.trajectory[i].x),
+         std::abs(banded.trajectory[i].y - ceres_side.trajectory[i].y)});
+  }
+  EXPECT_LT(largest, 1e-7);
+}
+
 // A sensor that reads 6% long with a 0.4 m offset, on simulated `kind`
 // records: the calibration recovers it and the APE falls below
 // `max_ape_ratio` times the uncalibrated solve's.
