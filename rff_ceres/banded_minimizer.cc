@@ -20,7 +20,7 @@ double Now() {
       .count();
 }
 
-std::string Format(const char* format, double a, double b) {
+std::string MessageWith(const char* format, double a, double b) {
   char text[160];
   std::snprintf(text, sizeof(text), format, a, b);
   return text;
@@ -54,10 +54,7 @@ bool BandedSolvable(const ceres::Problem& problem, const BandedColumns& columns,
               -std::numeric_limits<double>::max() ||
           problem.GetParameterUpperBound(block, i) <
               std::numeric_limits<double>::max()) {
-        *why =
-            "a parameter has bounds (the self-calibrations of "
-            "--estimate_range_calibration and --estimate_odometry_calibration "
-            "have)";
+        *why = "a parameter has bounds";
         return false;
       }
     }
@@ -68,11 +65,8 @@ bool BandedSolvable(const ceres::Problem& problem, const BandedColumns& columns,
   size->num_columns = banded.num_columns();
   for (int i = 0; i < static_cast<int>(first.size()); ++i) {
     size->entries += i - first[i] + 1;
-    // EnvelopeMatrix::Factorize's inner products of row i.
-    for (int j = first[i]; j <= i; ++j) {
-      size->multiply_adds += j - std::max(first[i], first[j]);
-    }
   }
+  size->multiply_adds = EnvelopeMatrix::FactorizationWork(first);
   return true;
 }
 
@@ -139,6 +133,11 @@ void MinimizeBanded(const ceres::Solver::Options& options,
   double x_norm = -1.0;
   double radius = options.initial_trust_region_radius;
   double decrease_factor = 2.0;
+  // A rejected or invalid step: LevenbergMarquardtStrategy::StepRejected.
+  auto Reject = [&] {
+    radius /= decrease_factor;
+    decrease_factor *= 2.0;
+  };
   int invalid_steps = 0;
   ceres::IterationSummary it;
   it.step_is_valid = it.step_is_successful = true;
@@ -176,10 +175,11 @@ void MinimizeBanded(const ceres::Solver::Options& options,
       }
     }
     if (Now() - start >= options.max_solver_time_in_seconds) {
-      return finish(ceres::NO_CONVERGENCE,
-                    Format("Maximum solver time reached. Total solver time: "
-                           "%e >= %e.",
-                           Now() - start, options.max_solver_time_in_seconds));
+      return finish(
+          ceres::NO_CONVERGENCE,
+          MessageWith("Maximum solver time reached. Total solver time: "
+                      "%e >= %e.",
+                      Now() - start, options.max_solver_time_in_seconds));
     }
     if (it.iteration >= options.max_num_iterations) {
       return finish(ceres::NO_CONVERGENCE,
@@ -189,16 +189,18 @@ void MinimizeBanded(const ceres::Solver::Options& options,
     }
     if (it.step_is_successful &&
         it.gradient_max_norm <= options.gradient_tolerance) {
-      return finish(ceres::CONVERGENCE,
-                    Format("Gradient tolerance reached. Gradient max norm: "
-                           "%e <= %e",
-                           it.gradient_max_norm, options.gradient_tolerance));
+      return finish(
+          ceres::CONVERGENCE,
+          MessageWith("Gradient tolerance reached. Gradient max norm: "
+                      "%e <= %e",
+                      it.gradient_max_norm, options.gradient_tolerance));
     }
     if (radius <= options.min_trust_region_radius) {
-      return finish(ceres::CONVERGENCE,
-                    Format("Minimum trust region radius reached. Trust region "
-                           "radius: %e <= %e",
-                           radius, options.min_trust_region_radius));
+      return finish(
+          ceres::CONVERGENCE,
+          MessageWith("Minimum trust region radius reached. Trust region "
+                      "radius: %e <= %e",
+                      radius, options.min_trust_region_radius));
     }
 
     iteration_start = Now();
@@ -224,12 +226,16 @@ void MinimizeBanded(const ceres::Solver::Options& options,
     double model_cost_change = 0.0;
     bool valid = system.Factorize();
     if (valid) {
-      const Eigen::VectorXd z = system.Solve(-scale.cwiseProduct(gradient));
+      const Eigen::VectorXd y =
+          system.SolveLower(-scale.cwiseProduct(gradient));
+      const Eigen::VectorXd z = system.SolveUpper(y);
       step = scale.cwiseProduct(z);
-      // The Gauss-Newton model's decrease -(g^T dx + dx^T H dx / 2), with
-      // z^T S H S z = -g^T dx - z^T D z from the solve: no product with H.
+      // The Gauss-Newton model's decrease -(g^T dx + dx^T H dx / 2) without
+      // a product with H: L L^T z = -S g gives -g^T dx = y^T y and
+      // z^T S H S z = y^T y - z^T D z, so it is (y^T y + z^T D z) / 2, a sum
+      // of squares (it assumes the solve's rounding, as Ceres's J dx does).
       model_cost_change =
-          -0.5 * gradient.dot(step) + 0.5 * z.dot(damping.cwiseProduct(z));
+          0.5 * (y.squaredNorm() + z.dot(damping.cwiseProduct(z)));
       valid = step.allFinite() && model_cost_change > 0.0;
     }
     next.step_solver_time_in_seconds = Now() - solve_start;
@@ -241,8 +247,7 @@ void MinimizeBanded(const ceres::Solver::Options& options,
             "Solver::Options::max_num_consecutive_invalid_steps: " +
                 std::to_string(options.max_num_consecutive_invalid_steps));
       }
-      radius /= decrease_factor;
-      decrease_factor *= 2.0;
+      Reject();
       next.cost = cost + fixed_cost;
       next.gradient_max_norm = it.gradient_max_norm;
       next.gradient_norm = it.gradient_norm;
@@ -256,23 +261,24 @@ void MinimizeBanded(const ceres::Solver::Options& options,
     if (!banded.Cost(candidate, &candidate_cost)) {
       candidate_cost = std::numeric_limits<double>::max();
     }
-    next.step_norm = step.norm();
+    next.step_norm = (x - candidate).norm();  // As Ceres: the ambient step.
     if (next.step_norm <=
         options.parameter_tolerance * (x_norm + options.parameter_tolerance)) {
       return finish(
           ceres::CONVERGENCE,
-          Format("Parameter tolerance reached. Relative step_norm: "
-                 "%e <= %e.",
-                 next.step_norm / (x_norm + options.parameter_tolerance),
-                 options.parameter_tolerance));
+          MessageWith("Parameter tolerance reached. Relative step_norm: "
+                      "%e <= %e.",
+                      next.step_norm / (x_norm + options.parameter_tolerance),
+                      options.parameter_tolerance));
     }
     next.cost_change = cost - candidate_cost;
     if (std::abs(next.cost_change) <= options.function_tolerance * cost) {
-      return finish(ceres::CONVERGENCE,
-                    Format("Function tolerance reached. |cost_change|/cost: "
-                           "%e <= %e",
-                           std::abs(next.cost_change) / cost,
-                           options.function_tolerance));
+      return finish(
+          ceres::CONVERGENCE,
+          MessageWith("Function tolerance reached. |cost_change|/cost: "
+                      "%e <= %e",
+                      std::abs(next.cost_change) / cost,
+                      options.function_tolerance));
     }
     next.relative_decrease = next.cost_change / model_cost_change;
     if (next.relative_decrease > options.min_relative_decrease) {
@@ -296,8 +302,7 @@ void MinimizeBanded(const ceres::Solver::Options& options,
       next.cost = candidate_cost + fixed_cost;
       next.gradient_max_norm = it.gradient_max_norm;
       next.gradient_norm = it.gradient_norm;
-      radius /= decrease_factor;
-      decrease_factor *= 2.0;
+      Reject();
     }
     it = next;
   }

@@ -19,9 +19,6 @@
 
 namespace rff {
 
-// The name --linear_solver takes for it.
-inline constexpr char kBandedCholesky[] = "BANDED_CHOLESKY";
-
 // The envelope of H in a column order: its columns (the variables), the
 // doubles it stores and the multiply-adds of one factorisation.
 struct BandedSize {

@@ -42,7 +42,7 @@ BandedProblem::BandedProblem(const ceres::Problem& problem,
     sizes_.push_back(place.second);
   }
   for (std::size_t r = 0; r < ids.size(); ++r) {
-    ResidualTerm term;
+    Term term;
     term.cost = problem.GetCostFunctionForResidualBlock(ids[r]);
     term.loss = problem.GetLossFunctionForResidualBlock(ids[r]);
     term.num_blocks = begin[r + 1] - begin[r];
@@ -61,7 +61,7 @@ BandedProblem::BandedProblem(const ceres::Problem& problem,
 std::vector<int> BandedProblem::EnvelopeFirst() const {
   std::vector<int> first(num_columns_);
   for (int i = 0; i < num_columns_; ++i) first[i] = i;
-  for (const ResidualTerm& term : terms_) {
+  for (const Term& term : terms_) {
     int lowest = num_columns_;
     for (int a = 0; a < term.num_blocks; ++a) {
       if (term.column[a] >= 0) lowest = std::min(lowest, term.column[a]);
@@ -94,7 +94,7 @@ void BandedProblem::Scatter(const Eigen::VectorXd& x) const {
 
 bool BandedProblem::FixedCost(double* cost) {
   *cost = 0.0;
-  for (const ResidualTerm& term : fixed_terms_) {
+  for (const Term& term : fixed_terms_) {
     double term_cost;
     if (!Evaluate(term, Eigen::VectorXd(), false, &term_cost)) return false;
     *cost += term_cost;
@@ -104,7 +104,7 @@ bool BandedProblem::FixedCost(double* cost) {
 
 bool BandedProblem::Cost(const Eigen::VectorXd& x, double* cost) {
   *cost = 0.0;
-  for (const ResidualTerm& term : terms_) {
+  for (const Term& term : terms_) {
     double term_cost;
     if (!Evaluate(term, x, /*jacobians=*/false, &term_cost)) return false;
     *cost += term_cost;
@@ -117,7 +117,7 @@ bool BandedProblem::Linearize(const Eigen::VectorXd& x, double* cost,
   *cost = 0.0;
   g->setZero(num_columns_);
   h->SetZero();
-  for (const ResidualTerm& term : terms_) {
+  for (const Term& term : terms_) {
     double term_cost;
     if (!Evaluate(term, x, /*jacobians=*/true, &term_cost)) return false;
     *cost += term_cost;
@@ -159,7 +159,7 @@ std::vector<double*> BandedProblem::ColumnOrder(
   return order;
 }
 
-bool BandedProblem::Evaluate(const ResidualTerm& term, const Eigen::VectorXd& x,
+bool BandedProblem::Evaluate(const Term& term, const Eigen::VectorXd& x,
                              bool jacobians, double* cost) {
   const int rows = term.cost->num_residuals();
   const std::size_t n = term.num_blocks;
@@ -210,7 +210,7 @@ bool BandedProblem::Evaluate(const ResidualTerm& term, const Eigen::VectorXd& x,
   return std::isfinite(*cost);
 }
 
-void BandedProblem::Accumulate(const ResidualTerm& term, Eigen::VectorXd* g,
+void BandedProblem::Accumulate(const Term& term, Eigen::VectorXd* g,
                                EnvelopeMatrix* h) const {
   const int rows = static_cast<int>(residual_buffer_.size());
   const double* residual = residual_buffer_.data();

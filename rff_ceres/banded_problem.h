@@ -24,18 +24,6 @@ struct BandedColumns {
   std::vector<double*> timed, placed, last;
 };
 
-// One residual block: its cost, loss and parameter blocks, each with its
-// first column in the system (-1 for a constant block) and size; the
-// arrays are BandedProblem's, shared by all terms.
-struct ResidualTerm {
-  const ceres::CostFunction* cost = nullptr;
-  const ceres::LossFunction* loss = nullptr;
-  int num_blocks = 0;
-  double* const* blocks = nullptr;
-  const int* column = nullptr;
-  const int* size = nullptr;
-};
-
 class BandedProblem {
  public:
   // The variables are the blocks of `columns` that are not constant and
@@ -67,24 +55,36 @@ class BandedProblem {
                  EnvelopeMatrix* h);
 
  private:
+  // One residual block: its cost, loss and parameter blocks, each with its
+  // first column in the system (-1 for a constant block) and size; the
+  // arrays are BandedProblem's, shared by all terms.
+  struct Term {
+    const ceres::CostFunction* cost = nullptr;
+    const ceres::LossFunction* loss = nullptr;
+    int num_blocks = 0;
+    double* const* blocks = nullptr;
+    const int* column = nullptr;
+    const int* size = nullptr;
+  };
+
   // The blocks of `columns` in column order, from the residuals' blocks
   // (residual r's at blocks_[begin[r]] up to begin[r + 1]).
   std::vector<double*> ColumnOrder(const BandedColumns& columns,
                                    const std::vector<int>& begin) const;
   // One term's cost at x and, with `jacobians`, its corrected residual and
   // Jacobian blocks in the buffers below.
-  bool Evaluate(const ResidualTerm& term, const Eigen::VectorXd& x,
-                bool jacobians, double* cost);
+  bool Evaluate(const Term& term, const Eigen::VectorXd& x, bool jacobians,
+                double* cost);
   // g += J^T r and the lower triangle of H += J^T J, block pair by pair,
   // from the last Evaluate.
-  void Accumulate(const ResidualTerm& term, Eigen::VectorXd* g,
+  void Accumulate(const Term& term, Eigen::VectorXd* g,
                   EnvelopeMatrix* h) const;
 
   std::vector<double*> variables_;  // In column order, with their sizes.
   std::vector<int> variable_sizes_;
   std::vector<double*> blocks_;  // Every term's blocks, columns and sizes.
   std::vector<int> columns_, sizes_;
-  std::vector<ResidualTerm> terms_, fixed_terms_;
+  std::vector<Term> terms_, fixed_terms_;
   int num_columns_ = 0;
   std::vector<const double*> parameters_;
   std::vector<std::vector<double>> jacobian_rows_;

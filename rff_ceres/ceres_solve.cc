@@ -181,7 +181,14 @@ bool RunSolve(const SolverOptions& solver, ceres::Solver::Options ceres_options,
     const BandedColumns columns = problem->BandColumns();
     BandedSize size;
     std::string why;
-    if (BandedSolvable(*problem->problem(), columns, &size, &why)) {
+    if (!BandedSolvable(*problem->problem(), columns, &size, &why)) {
+      // The only bounded blocks here.
+      if (why == "a parameter has bounds") {
+        why +=
+            " (the self-calibrations of --estimate_range_calibration and "
+            "--estimate_odometry_calibration have)";
+      }
+    } else {
       // The envelope twice: H and the factor of the damped system.
       const double bytes = 16.0 * static_cast<double>(size.entries);
       const double limit = MemoryLimitBytes(solver.max_memory_gb);

@@ -17,6 +17,10 @@ namespace rff {
 
 struct SlamResult;  // slam_solver.h, which includes this header.
 
+// The name --linear_solver takes for our banded Levenberg-Marquardt
+// (banded_minimizer.h).
+inline constexpr char kBandedCholesky[] = "BANDED_CHOLESKY";
+
 // Ceres solver settings, named as Ceres names them.
 struct SolverOptions {
   // "auto" (chosen from the problem's structure, see ChooseLinearSolver) or

@@ -45,17 +45,36 @@ bool EnvelopeMatrix::Factorize() {
   return true;
 }
 
+double EnvelopeMatrix::FactorizationWork(const std::vector<int>& first) {
+  double work = 0.0;
+  for (int i = 0; i < static_cast<int>(first.size()); ++i) {
+    // Factorize's inner products of row i.
+    for (int j = first[i]; j <= i; ++j)
+      work += j - std::max(first[i], first[j]);
+  }
+  return work;
+}
+
 Eigen::VectorXd EnvelopeMatrix::Solve(const Eigen::VectorXd& b) const {
-  Eigen::VectorXd x = b;
-  // L y = b, rows in order.
+  return SolveUpper(SolveLower(b));
+}
+
+// L y = b, rows in order.
+Eigen::VectorXd EnvelopeMatrix::SolveLower(const Eigen::VectorXd& b) const {
+  Eigen::VectorXd y = b;
   for (int i = 0; i < size(); ++i) {
     const double* li = row(i);
     const int fi = first_[i];
-    double sum = x[i];
-    for (int k = fi; k < i; ++k) sum -= li[k - fi] * x[k];
-    x[i] = sum / li[i - fi];
+    double sum = y[i];
+    for (int k = fi; k < i; ++k) sum -= li[k - fi] * y[k];
+    y[i] = sum / li[i - fi];
   }
-  // L^T x = y, columns in reverse: row i of L scatters into the earlier x.
+  return y;
+}
+
+// L^T x = y, columns in reverse: row i of L scatters into the earlier x.
+Eigen::VectorXd EnvelopeMatrix::SolveUpper(const Eigen::VectorXd& y) const {
+  Eigen::VectorXd x = y;
   for (int i = size() - 1; i >= 0; --i) {
     const double* li = row(i);
     const int fi = first_[i];

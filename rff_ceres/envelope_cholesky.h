@@ -37,8 +37,12 @@ class EnvelopeMatrix {
   // Replaces the matrix by its Cholesky factor L; false (matrix left
   // partly overwritten) when a pivot is not positive and finite.
   bool Factorize();
-  // A^-1 b with the factor of Factorize.
+  // A^-1 b with the factor of Factorize: L^-T (L^-1 b), each half apart.
   Eigen::VectorXd Solve(const Eigen::VectorXd& b) const;
+  Eigen::VectorXd SolveLower(const Eigen::VectorXd& b) const;
+  Eigen::VectorXd SolveUpper(const Eigen::VectorXd& y) const;
+  // The multiply-adds of Factorize on an envelope that starts at `first`.
+  static double FactorizationWork(const std::vector<int>& first);
 
  private:
   std::vector<int> first_;

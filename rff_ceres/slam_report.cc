@@ -81,8 +81,8 @@ void PrintSlamSummary(const SlamOptions& options, const SlamResult& result,
        << result.total_iterations << " iterations, "
        << ceres::TerminationTypeToString(s.termination_type) << "\n"
        << "  cost         " << s.initial_cost << " -> " << s.final_cost << "\n"
-       << "  time         " << s.total_time_in_seconds << " s in Ceres, "
-       << result.solve_seconds << " s total\n";
+       << "  time         " << s.total_time_in_seconds
+       << " s in the final solve, " << result.solve_seconds << " s total\n";
   *out << "  start        initial trajectory from the "
        << result.initial_trajectory;
   if (result.start_heading.resolved) {
