@@ -57,6 +57,23 @@ double LargestPositionDifference(const SlamResult& a, const SlamResult& b) {
   return largest;
 }
 
+// `options` solved with BANDED_CHOLESKY and with Ceres's sparse Cholesky.
+::testing::AssertionResult SolveWithBothCholeskys(const Dataset& dataset,
+                                                  SlamOptions options,
+                                                  SlamResult* banded,
+                                                  SlamResult* ceres_side) {
+  std::string error;
+  options.solver.linear_solver = "BANDED_CHOLESKY";
+  if (!RunSlam(dataset, options, banded, &error)) {
+    return ::testing::AssertionFailure() << "banded: " << error;
+  }
+  options.solver.linear_solver = "SPARSE_NORMAL_CHOLESKY";
+  if (!RunSlam(dataset, options, ceres_side, &error)) {
+    return ::testing::AssertionFailure() << "sparse: " << error;
+  }
+  return ::testing::AssertionSuccess();
+}
+
 double ApeTranslation(const Dataset& dataset, const SlamResult& result) {
   Evaluation evaluation;
   std::string error;
@@ -143,10 +160,7 @@ TEST(SlamSolverTest, BandedCholeskyMatchesCeresSparseCholesky) {
   options.prior = "wnoa";
   options.learn_hyperparameters = "off";
   SlamResult banded, ceres_side;
-  options.solver.linear_solver = "BANDED_CHOLESKY";
-  ASSERT_TRUE(RunSlam(dataset, options, &banded, &error)) << error;
-  options.solver.linear_solver = "SPARSE_NORMAL_CHOLESKY";
-  ASSERT_TRUE(RunSlam(dataset, options, &ceres_side, &error)) << error;
+  ASSERT_TRUE(SolveWithBothCholeskys(dataset, options, &banded, &ceres_side));
   EXPECT_EQ(banded.linear_solver, "BANDED_CHOLESKY");
   EXPECT_EQ(banded.total_iterations, ceres_side.total_iterations);
   EXPECT_GT(banded.total_iterations, 3);
@@ -626,10 +640,7 @@ TEST(SlamSolverTest, IncrementalBandedCholeskyMatchesCeres) {
   options.incremental.every = 40;
   options.incremental.lag = 15.0;
   SlamResult banded, ceres_side;
-  options.solver.linear_solver = "BANDED_CHOLESKY";
-  ASSERT_TRUE(RunSlam(dataset, options, &banded, &error)) << error;
-  options.solver.linear_solver = "SPARSE_NORMAL_CHOLESKY";
-  ASSERT_TRUE(RunSlam(dataset, options, &ceres_side, &error)) << error;
+  ASSERT_TRUE(SolveWithBothCholeskys(dataset, options, &banded, &ceres_side));
   ASSERT_EQ(banded.updates.size(), ceres_side.updates.size());
   ASSERT_GT(banded.updates.size(), 5u);
   for (std::size_t u = 0; u < banded.updates.size(); ++u) {
