@@ -29,7 +29,7 @@ std::string MessageWith(const char* format, double a, double b) {
 }  // namespace
 
 bool BandedSolvable(const ceres::Problem& problem, const BandedColumns& columns,
-                    BandedSize* size, std::string* why) {
+                    std::string* why) {
   std::set<const double*> blocks;
   for (const auto* set : {&columns.timed, &columns.placed, &columns.last}) {
     blocks.insert(set->begin(), set->end());
@@ -59,19 +59,11 @@ bool BandedSolvable(const ceres::Problem& problem, const BandedColumns& columns,
       }
     }
   }
-  const BandedProblem banded(problem, columns);
-  const std::vector<int> first = banded.EnvelopeFirst();
-  *size = BandedSize();
-  size->num_columns = banded.num_columns();
-  for (int i = 0; i < static_cast<int>(first.size()); ++i) {
-    size->entries += i - first[i] + 1;
-  }
-  size->multiply_adds = EnvelopeMatrix::FactorizationWork(first);
   return true;
 }
 
 void MinimizeBanded(const ceres::Solver::Options& options,
-                    const BandedColumns& columns, ceres::Problem* problem,
+                    BandedProblem* banded, ceres::Problem* problem,
                     ceres::Solver::Summary* summary) {
   CHECK(options.jacobi_scaling && !options.use_nonmonotonic_steps &&
         !options.use_inner_iterations)
@@ -88,11 +80,10 @@ void MinimizeBanded(const ceres::Solver::Options& options,
   summary->num_threads_used = 1;
   summary->num_successful_steps = summary->num_unsuccessful_steps = 0;
 
-  BandedProblem banded(*problem, columns);
-  const int n = banded.num_columns();
+  const int n = banded->num_columns();
   summary->num_parameters_reduced = n;
-  summary->num_parameter_blocks_reduced = banded.num_variable_blocks();
-  const Eigen::VectorXd start_values = banded.Gather();
+  summary->num_parameter_blocks_reduced = banded->num_variable_blocks();
+  const Eigen::VectorXd start_values = banded->Gather();
   Eigen::VectorXd x = start_values, best = x, gradient(n);
   // Costs without the fixed cost, which the reported ones include.
   double cost = 0.0, fixed_cost = 0.0;
@@ -100,7 +91,7 @@ void MinimizeBanded(const ceres::Solver::Options& options,
     summary->termination_type = type;
     summary->message = message;
     // As Ceres: a failed solve leaves the starting values.
-    banded.Scatter(summary->IsSolutionUsable() ? best : start_values);
+    banded->Scatter(summary->IsSolutionUsable() ? best : start_values);
     summary->final_cost = summary->initial_cost;
     for (const ceres::IterationSummary& i : summary->iterations) {
       summary->final_cost = std::min(summary->final_cost, i.cost);
@@ -108,7 +99,7 @@ void MinimizeBanded(const ceres::Solver::Options& options,
     summary->minimizer_time_in_seconds = Now() - start;
     summary->total_time_in_seconds = summary->minimizer_time_in_seconds;
   };
-  if (!banded.FixedCost(&fixed_cost)) {
+  if (!banded->FixedCost(&fixed_cost)) {
     return finish(ceres::FAILURE, "Unable to evaluate the fixed cost.");
   }
   summary->fixed_cost = fixed_cost;
@@ -118,9 +109,9 @@ void MinimizeBanded(const ceres::Solver::Options& options,
                   "Function tolerance reached. No non-constant parameter "
                   "blocks found.");
   }
-  EnvelopeMatrix hessian(banded.EnvelopeFirst());
-  EnvelopeMatrix system(banded.EnvelopeFirst());
-  if (!banded.Linearize(x, &cost, &gradient, &hessian)) {
+  EnvelopeMatrix hessian(banded->envelope_first());
+  EnvelopeMatrix system(banded->envelope_first());
+  if (!banded->Linearize(x, &cost, &gradient, &hessian)) {
     return finish(ceres::FAILURE, "Residual and Jacobian evaluation failed.");
   }
   // Jacobi scaling from the first Jacobian, kept for the whole solve.
@@ -162,7 +153,7 @@ void MinimizeBanded(const ceres::Solver::Options& options,
     it.iteration_time_in_seconds = Now() - iteration_start;
     it.cumulative_time_in_seconds = Now() - start;
     summary->iterations.push_back(it);
-    if (options.update_state_every_iteration) banded.Scatter(x);
+    if (options.update_state_every_iteration) banded->Scatter(x);
     for (ceres::IterationCallback* callback : options.callbacks) {
       const ceres::CallbackReturnType answer = (*callback)(it);
       if (answer == ceres::SOLVER_ABORT) {
@@ -258,7 +249,7 @@ void MinimizeBanded(const ceres::Solver::Options& options,
     next.step_is_valid = true;
     const Eigen::VectorXd candidate = x + step;
     double candidate_cost;
-    if (!banded.Cost(candidate, &candidate_cost)) {
+    if (!banded->Cost(candidate, &candidate_cost)) {
       candidate_cost = std::numeric_limits<double>::max();
     }
     next.step_norm = (x - candidate).norm();  // As Ceres: the ambient step.
@@ -284,7 +275,7 @@ void MinimizeBanded(const ceres::Solver::Options& options,
     if (next.relative_decrease > options.min_relative_decrease) {
       x = candidate;
       x_norm = x.norm();
-      if (!banded.Linearize(x, &cost, &gradient, &hessian)) {
+      if (!banded->Linearize(x, &cost, &gradient, &hessian)) {
         return finish(ceres::FAILURE,
                       "Residual and Jacobian evaluation failed.");
       }

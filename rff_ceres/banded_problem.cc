@@ -56,6 +56,17 @@ BandedProblem::BandedProblem(const ceres::Problem& problem,
     // tolerance tests and the step quality.
     (variable ? terms_ : fixed_terms_).push_back(term);
   }
+  envelope_first_ = EnvelopeFirst();
+}
+
+BandedSize BandedProblem::Size() const {
+  BandedSize size;
+  size.num_columns = num_columns_;
+  for (int i = 0; i < num_columns_; ++i) {
+    size.entries += i - envelope_first_[i] + 1;
+  }
+  size.multiply_adds = EnvelopeMatrix::FactorizationWork(envelope_first_);
+  return size;
 }
 
 std::vector<int> BandedProblem::EnvelopeFirst() const {

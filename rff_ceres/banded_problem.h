@@ -5,6 +5,7 @@
 #ifndef RFF_CERES_BANDED_PROBLEM_H_
 #define RFF_CERES_BANDED_PROBLEM_H_
 
+#include <cstdint>
 #include <vector>
 
 #include "Eigen/Core"
@@ -24,11 +25,20 @@ struct BandedColumns {
   std::vector<double*> timed, placed, last;
 };
 
+// The envelope of H in a column order: its columns (the variables), the
+// doubles it stores and the multiply-adds of one factorisation.
+struct BandedSize {
+  int num_columns = 0;
+  std::int64_t entries = 0;
+  double multiply_adds = 0.0;
+};
+
 class BandedProblem {
  public:
   // The variables are the blocks of `columns` that are not constant and
   // that a residual uses (as Ceres's preprocessor keeps them), in column
-  // order; residuals on constant blocks only are the fixed cost.
+  // order; residuals on constant blocks only are the fixed cost. `columns`
+  // must hold every block of `problem` once (BandedSolvable checks it).
   BandedProblem(const ceres::Problem& problem, const BandedColumns& columns);
 
   int num_columns() const { return num_columns_; }
@@ -37,7 +47,8 @@ class BandedProblem {
   }
   // Row i of H = J^T J stores from the first column any residual couples
   // to column i.
-  std::vector<int> EnvelopeFirst() const;
+  const std::vector<int>& envelope_first() const { return envelope_first_; }
+  BandedSize Size() const;
 
   // The variables' values as a state vector, and back.
   Eigen::VectorXd Gather() const;
@@ -67,6 +78,7 @@ class BandedProblem {
     const int* size = nullptr;
   };
 
+  std::vector<int> EnvelopeFirst() const;
   // The blocks of `columns` in column order, from the residuals' blocks
   // (residual r's at blocks_[begin[r]] up to begin[r + 1]).
   std::vector<double*> ColumnOrder(const BandedColumns& columns,
@@ -86,6 +98,7 @@ class BandedProblem {
   std::vector<int> columns_, sizes_;
   std::vector<Term> terms_, fixed_terms_;
   int num_columns_ = 0;
+  std::vector<int> envelope_first_;
   std::vector<const double*> parameters_;
   std::vector<std::vector<double>> jacobian_rows_;
   std::vector<double*> jacobian_pointers_;

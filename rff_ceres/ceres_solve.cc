@@ -4,6 +4,7 @@
 #include <cctype>
 #include <cmath>
 #include <cstdio>
+#include <memory>
 
 #include "ceres/types.h"
 #include "glog/logging.h"
@@ -179,9 +180,9 @@ bool RunSolve(const SolverOptions& solver, ceres::Solver::Options ceres_options,
        ceres_options.trust_region_strategy_type ==
            ceres::LEVENBERG_MARQUARDT)) {
     const BandedColumns columns = problem->BandColumns();
-    BandedSize size;
     std::string why;
-    if (!BandedSolvable(*problem->problem(), columns, &size, &why)) {
+    std::unique_ptr<BandedProblem> banded;
+    if (!BandedSolvable(*problem->problem(), columns, &why)) {
       // The only bounded blocks here.
       if (why == "a parameter has bounds") {
         why +=
@@ -189,6 +190,8 @@ bool RunSolve(const SolverOptions& solver, ceres::Solver::Options ceres_options,
             "--estimate_odometry_calibration have)";
       }
     } else {
+      banded = std::make_unique<BandedProblem>(*problem->problem(), columns);
+      const BandedSize size = banded->Size();
       // The envelope twice: H and the factor of the damped system.
       const double bytes = 16.0 * static_cast<double>(size.entries);
       const double limit = MemoryLimitBytes(solver.max_memory_gb);
@@ -217,7 +220,7 @@ bool RunSolve(const SolverOptions& solver, ceres::Solver::Options ceres_options,
             "banded states: Levenberg-Marquardt on a Cholesky of the whole "
             "system in time order";
       }
-      MinimizeBanded(ceres_options, columns, problem->problem(),
+      MinimizeBanded(ceres_options, banded.get(), problem->problem(),
                      &result->summary);
       return CheckSolve(result->summary, problem, error);
     }

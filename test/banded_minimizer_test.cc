@@ -122,6 +122,19 @@ ceres::Solver::Options SparseCholesky() {
   return options;
 }
 
+// `problem` laid out as `columns` and minimised by the banded loop.
+void Minimize(const ceres::Solver::Options& options,
+              const BandedColumns& columns, ceres::Problem* problem,
+              ceres::Solver::Summary* summary) {
+  BandedProblem banded(*problem, columns);
+  MinimizeBanded(options, &banded, problem, summary);
+}
+
+// The envelope's size with `problem` laid out as `columns`.
+BandedSize SizeOf(const ceres::Problem& problem, const BandedColumns& columns) {
+  return BandedProblem(problem, columns).Size();
+}
+
 // Ceres's own trust-region loop and the banded one take the same steps:
 // iteration by iteration the same acceptance, cost, step quality and
 // radius. Returns the banded summary.
@@ -132,13 +145,12 @@ ceres::Solver::Summary ExpectSameAsCeres(ceres::LossFunction* loss,
       banded_side(80, loss, outlier, local, landmark_error);
   ceres::Solver::Summary expected, actual;
   ceres::Solve(SparseCholesky(), ceres_side.problem.get(), &expected);
-  BandedSize size;
   std::string why;
-  EXPECT_TRUE(BandedSolvable(*banded_side.problem, banded_side.Columns(local),
-                             &size, &why))
+  EXPECT_TRUE(
+      BandedSolvable(*banded_side.problem, banded_side.Columns(local), &why))
       << why;
-  MinimizeBanded(SparseCholesky(), banded_side.Columns(local),
-                 banded_side.problem.get(), &actual);
+  Minimize(SparseCholesky(), banded_side.Columns(local),
+           banded_side.problem.get(), &actual);
   EXPECT_EQ(expected.termination_type, ceres::CONVERGENCE) << expected.message;
   EXPECT_EQ(actual.termination_type, expected.termination_type);
   EXPECT_EQ(actual.num_successful_steps, expected.num_successful_steps);
@@ -200,12 +212,10 @@ TEST(BandedMinimizerTest, MatchesCeresThroughRejectedSteps) {
 TEST(BandedMinimizerTest, MatchesCeresWithLandmarksPlacedAfterTheirSightings) {
   ExpectSameAsCeres(nullptr, 0.0, /*local=*/true);
   ChainProblem chain(90, nullptr, 0.0, /*local=*/true);
-  BandedSize placed, last;
   std::string why;
-  ASSERT_TRUE(
-      BandedSolvable(*chain.problem, chain.Columns(true), &placed, &why));
-  ASSERT_TRUE(
-      BandedSolvable(*chain.problem, chain.Columns(false), &last, &why));
+  ASSERT_TRUE(BandedSolvable(*chain.problem, chain.Columns(true), &why));
+  const BandedSize placed = SizeOf(*chain.problem, chain.Columns(true));
+  const BandedSize last = SizeOf(*chain.problem, chain.Columns(false));
   // The points' rows: 1 + 2 + 3 + 4 + 88 * (5 + 6) = 978. Last, landmark
   // j's rows reach back to its first sighting: 181 + 182, 123 + 124,
   // 65 + 66. Placed, each spans its 30 points (61 + 62), and the two points
@@ -238,7 +248,7 @@ TEST(BandedMinimizerTest, MatchesCeresWithFixedCostAndAnUnusedBlock) {
   ceres::Solve(options, ceres_side.problem.get(), &expected);
   BandedColumns columns = banded_side.Columns();
   columns.last.push_back(banded_unused.data());
-  MinimizeBanded(options, columns, banded_side.problem.get(), &actual);
+  Minimize(options, columns, banded_side.problem.get(), &actual);
   ASSERT_EQ(expected.termination_type, ceres::CONVERGENCE);
   EXPECT_EQ(actual.termination_type, ceres::CONVERGENCE);
   EXPECT_EQ(actual.iterations.size(), expected.iterations.size());
@@ -262,8 +272,7 @@ TEST(BandedMinimizerTest, NothingToSolveIsConvergedAtTheFixedCost) {
   }
   ceres::Solver::Summary expected, actual;
   ceres::Solve(SparseCholesky(), chain.problem.get(), &expected);
-  MinimizeBanded(SparseCholesky(), chain.Columns(), chain.problem.get(),
-                 &actual);
+  Minimize(SparseCholesky(), chain.Columns(), chain.problem.get(), &actual);
   EXPECT_EQ(actual.termination_type, ceres::CONVERGENCE);
   EXPECT_EQ(actual.message, expected.message);
   EXPECT_EQ(actual.iterations.size(), 0u);
@@ -277,7 +286,7 @@ TEST(BandedMinimizerTest, StopsAtTheIterationCapAndOnACallback) {
   ceres::Solver::Options options = SparseCholesky();
   options.max_num_iterations = 2;
   ceres::Solver::Summary summary;
-  MinimizeBanded(options, chain.Columns(), chain.problem.get(), &summary);
+  Minimize(options, chain.Columns(), chain.problem.get(), &summary);
   EXPECT_EQ(summary.termination_type, ceres::NO_CONVERGENCE);
   EXPECT_EQ(summary.message,
             "Maximum number of iterations reached. Number of iterations: 2.");
@@ -292,7 +301,7 @@ TEST(BandedMinimizerTest, StopsAtTheIterationCapAndOnACallback) {
   options = SparseCholesky();
   options.callbacks.push_back(&abort);
   const Eigen::VectorXd start = chain.Values();
-  MinimizeBanded(options, chain.Columns(), chain.problem.get(), &summary);
+  Minimize(options, chain.Columns(), chain.problem.get(), &summary);
   EXPECT_EQ(summary.termination_type, ceres::USER_FAILURE);
   EXPECT_EQ(summary.message, "User callback returned SOLVER_ABORT.");
   EXPECT_EQ(summary.iterations.size(), 2u);
@@ -302,27 +311,26 @@ TEST(BandedMinimizerTest, StopsAtTheIterationCapAndOnACallback) {
 
 TEST(BandedMinimizerTest, RefusesBoundsAndAnIncompleteOrder) {
   ChainProblem chain(10, nullptr);
-  BandedSize size;
   std::string why;
   BandedColumns columns = chain.Columns();
   columns.last.pop_back();
-  EXPECT_FALSE(BandedSolvable(*chain.problem, columns, &size, &why));
+  EXPECT_FALSE(BandedSolvable(*chain.problem, columns, &why));
   EXPECT_EQ(why, "the columns do not hold every parameter block once");
   columns = chain.Columns();
   columns.last.push_back(columns.timed[0]);
   columns.last.erase(columns.last.begin());
-  EXPECT_FALSE(BandedSolvable(*chain.problem, columns, &size, &why));
+  EXPECT_FALSE(BandedSolvable(*chain.problem, columns, &why));
   EXPECT_EQ(why, "the columns do not hold every parameter block once");
   chain.problem->SetParameterLowerBound(chain.points[3].data(), 0, -1.0);
-  EXPECT_FALSE(BandedSolvable(*chain.problem, chain.Columns(), &size, &why));
+  EXPECT_FALSE(BandedSolvable(*chain.problem, chain.Columns(), &why));
   EXPECT_EQ(why, "a parameter has bounds");
 }
 
 TEST(BandedMinimizerTest, SizesTheEnvelopeOfABandWithABorder) {
   ChainProblem chain(10, nullptr);
-  BandedSize size;
   std::string why;
-  ASSERT_TRUE(BandedSolvable(*chain.problem, chain.Columns(), &size, &why));
+  ASSERT_TRUE(BandedSolvable(*chain.problem, chain.Columns(), &why));
+  const BandedSize size = SizeOf(*chain.problem, chain.Columns());
   // Point k's rows reach back to point k - 2 (the second differences): row
   // i stores min(i, 4 + i % 2) + 1 columns. Landmarks: full rows.
   std::int64_t expected = 0;
