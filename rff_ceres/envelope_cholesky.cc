@@ -15,32 +15,87 @@ EnvelopeMatrix::EnvelopeMatrix(std::vector<int> first)
     start_[i + 1] = start_[i] + (static_cast<std::int64_t>(i) - first_[i] + 1);
   }
   values_.assign(start_.back(), 0.0);
+  inverse_diagonal_.assign(first_.size(), 0.0);
 }
 
 void EnvelopeMatrix::SetZero() {
   std::fill(values_.begin(), values_.end(), 0.0);
 }
 
+// L_ij for the `count` rows from `group` on, all stored from column `first`,
+// at every column j left of the group: one pass over row j for all of them,
+// their sums independent chains.
+template <int kCount>
+void EnvelopeMatrix::EliminateRowsAlike(int group, int first) {
+  double* l[kCount];
+  for (int r = 0; r < kCount; ++r) l[r] = row(group + r);
+  for (int j = first; j < group; ++j) {
+    const double* lj = row(j);
+    const int fj = first_[j];
+    const int k0 = std::max(first, fj);
+    const double* b = lj + (k0 - fj);
+    const int o = k0 - first;
+    double sum[kCount] = {};
+    for (int k = 0; k < j - k0; ++k) {
+      for (int r = 0; r < kCount; ++r) sum[r] += l[r][o + k] * b[k];
+    }
+    const double inverse = inverse_diagonal_[j];
+    for (int r = 0; r < kCount; ++r) {
+      l[r][j - first] = (l[r][j - first] - sum[r]) * inverse;
+    }
+  }
+}
+
 // Row by row (the "bordering" form): L_ij = (A_ij - sum_k L_ik L_jk) / L_jj
 // over the columns k both rows store, then L_ii = sqrt(A_ii - sum_k L_ik^2).
+// Each L_ij needs L_i,j-1, so a row is one chain of dependent operations:
+// rows that start at the same column (a state's) are taken together, their
+// entries left of the group in one pass, then the group's own triangle.
 bool EnvelopeMatrix::Factorize() {
-  for (int i = 0; i < size(); ++i) {
-    double* li = row(i);
-    const int fi = first_[i];
-    for (int j = fi; j < i; ++j) {
-      const double* lj = row(j);
-      const int fj = first_[j];
-      const int k0 = std::max(fi, fj);
-      double sum = 0.0;
-      const double* a = li + (k0 - fi);
-      const double* b = lj + (k0 - fj);
-      for (int k = 0; k < j - k0; ++k) sum += a[k] * b[k];
-      li[j - fi] = (li[j - fi] - sum) / lj[j - fj];
+  constexpr int kMaxRowsAtOnce = 6;
+  int end = 0;
+  for (int group = 0; group < size(); group = end) {
+    const int first = first_[group];
+    end = group + 1;
+    while (end < size() && end - group < kMaxRowsAtOnce &&
+           first_[end] == first) {
+      ++end;
     }
-    double diagonal = li[i - fi];
-    for (int k = 0; k < i - fi; ++k) diagonal -= li[k] * li[k];
-    if (!(diagonal > 0.0) || !std::isfinite(diagonal)) return false;
-    li[i - fi] = std::sqrt(diagonal);
+    switch (end - group) {
+      case 1:
+        EliminateRowsAlike<1>(group, first);
+        break;
+      case 2:
+        EliminateRowsAlike<2>(group, first);
+        break;
+      case 3:
+        EliminateRowsAlike<3>(group, first);
+        break;
+      case 4:
+        EliminateRowsAlike<4>(group, first);
+        break;
+      case 5:
+        EliminateRowsAlike<5>(group, first);
+        break;
+      default:
+        EliminateRowsAlike<6>(group, first);
+        break;
+    }
+    for (int i = group; i < end; ++i) {
+      double* li = row(i);
+      // The group's own triangle: row j of it stores from `first` too.
+      for (int j = group; j < i; ++j) {
+        const double* lj = row(j);
+        double sum = 0.0;
+        for (int k = 0; k < j - first; ++k) sum += li[k] * lj[k];
+        li[j - first] = (li[j - first] - sum) * inverse_diagonal_[j];
+      }
+      double diagonal = li[i - first];
+      for (int k = 0; k < i - first; ++k) diagonal -= li[k] * li[k];
+      if (!(diagonal > 0.0) || !std::isfinite(diagonal)) return false;
+      li[i - first] = std::sqrt(diagonal);
+      inverse_diagonal_[i] = 1.0 / li[i - first];
+    }
   }
   return true;
 }

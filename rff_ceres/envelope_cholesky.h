@@ -45,9 +45,16 @@ class EnvelopeMatrix {
   static double FactorizationWork(const std::vector<int>& first);
 
  private:
+  // Factorize's entries left of a group of rows that start alike.
+  template <int kCount>
+  void EliminateRowsAlike(int group, int first);
+
   std::vector<int> first_;
   std::vector<std::int64_t> start_;  // Row i's entries at start_[i].
   std::vector<double> values_;
+  // 1 / L_jj: a multiply, not a divide, on the chain each row's entries
+  // form (L_ij needs L_i,j-1).
+  std::vector<double> inverse_diagonal_;
 };
 
 }  // namespace rff

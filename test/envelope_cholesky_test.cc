@@ -71,6 +71,41 @@ TEST(EnvelopeCholeskyTest, FactorMatchesEigensLowerFactor) {
   }
 }
 
+// Blocks of 1 to 9 variables, each coupled to the next, as states are: the
+// rows of a block start alike (at the block before), in runs longer and
+// shorter than those Factorize takes together.
+TEST(EnvelopeCholeskyTest, FactorMatchesEigensWithBlocksOfEverySize) {
+  std::vector<int> begin = {0};
+  for (int size = 1; size <= 9; ++size) begin.push_back(begin.back() + size);
+  for (int size = 9; size >= 1; size -= 2) begin.push_back(begin.back() + size);
+  const int n = begin.back();
+  std::mt19937 random(3);
+  std::normal_distribution<double> normal;
+  Eigen::MatrixXd j = Eigen::MatrixXd::Zero(4 * n, n);
+  int r = 0;
+  for (std::size_t b = 0; b + 2 < begin.size(); ++b) {
+    for (int row = 0; row < begin[b + 2] - begin[b] + 2; ++row, ++r) {
+      for (int c = begin[b]; c < begin[b + 2]; ++c) j(r, c) = normal(random);
+    }
+  }
+  const Eigen::MatrixXd a = j.topRows(r).transpose() * j.topRows(r);
+  std::vector<int> first(n);
+  for (std::size_t b = 0; b + 1 < begin.size(); ++b) {
+    for (int i = begin[b]; i < begin[b + 1]; ++i) {
+      first[i] = begin[b == 0 ? 0 : b - 1];
+    }
+  }
+  EnvelopeMatrix e = FromDense(a, first);
+  ASSERT_TRUE(e.Factorize());
+  const Eigen::MatrixXd l = a.llt().matrixL();
+  for (int i = 0; i < n; ++i) {
+    for (int k = 0; k <= i; ++k) {
+      const double entry = k >= first[i] ? e(i, k) : 0.0;
+      EXPECT_NEAR(entry, l(i, k), 1e-12 * l.norm()) << i << ", " << k;
+    }
+  }
+}
+
 TEST(EnvelopeCholeskyTest, RefusesAnIndefiniteOrNonFiniteMatrix) {
   EnvelopeMatrix indefinite({0, 0});
   indefinite(0, 0) = 1.0;
