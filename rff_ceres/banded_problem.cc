@@ -8,6 +8,43 @@
 
 namespace rff {
 
+std::vector<double*> BandedBlockOrder(const ceres::Problem& problem,
+                                      const BandedColumns& columns) {
+  std::unordered_map<const double*, int> time_index, anchor;
+  time_index.reserve(columns.timed.size());
+  anchor.reserve(columns.placed.size());
+  for (std::size_t k = 0; k < columns.timed.size(); ++k) {
+    time_index[columns.timed[k]] = static_cast<int>(k);
+  }
+  for (const double* block : columns.placed) anchor[block] = -1;
+  std::vector<ceres::ResidualBlockId> ids;
+  problem.GetResidualBlocks(&ids);
+  std::vector<double*> blocks;
+  for (const ceres::ResidualBlockId id : ids) {
+    problem.GetParameterBlocksForResidualBlock(id, &blocks);
+    int latest = -1;
+    for (const double* block : blocks) {
+      const auto it = time_index.find(block);
+      if (it != time_index.end()) latest = std::max(latest, it->second);
+    }
+    for (const double* block : blocks) {
+      const auto it = anchor.find(block);
+      if (it != anchor.end()) it->second = std::max(it->second, latest);
+    }
+  }
+  std::vector<std::vector<double*>> after(columns.timed.size() + 1);
+  for (double* block : columns.placed) {
+    after[anchor[block] + 1].push_back(block);
+  }
+  std::vector<double*> order = after[0];
+  for (std::size_t k = 0; k < columns.timed.size(); ++k) {
+    order.push_back(columns.timed[k]);
+    order.insert(order.end(), after[k + 1].begin(), after[k + 1].end());
+  }
+  order.insert(order.end(), columns.last.begin(), columns.last.end());
+  return order;
+}
+
 BandedProblem::BandedProblem(const ceres::Problem& problem,
                              const BandedColumns& columns) {
   std::vector<ceres::ResidualBlockId> ids;
@@ -25,7 +62,7 @@ BandedProblem::BandedProblem(const ceres::Problem& problem,
   layout.reserve(problem.NumParameterBlocks());
   // As Ceres's preprocessor: blocks no residual uses are no variables.
   const std::unordered_set<const double*> used(blocks_.begin(), blocks_.end());
-  for (double* block : ColumnOrder(columns, begin)) {
+  for (double* block : BandedBlockOrder(problem, columns)) {
     const int size = problem.ParameterBlockSize(block);
     if (problem.IsParameterBlockConstant(block) || used.count(block) == 0) {
       layout[block] = {-1, size};
@@ -135,39 +172,6 @@ bool BandedProblem::Linearize(const Eigen::VectorXd& x, double* cost,
     Accumulate(term, g, h);
   }
   return true;
-}
-
-std::vector<double*> BandedProblem::ColumnOrder(
-    const BandedColumns& columns, const std::vector<int>& begin) const {
-  std::unordered_map<const double*, int> time_index, anchor;
-  time_index.reserve(columns.timed.size());
-  anchor.reserve(columns.placed.size());
-  for (std::size_t k = 0; k < columns.timed.size(); ++k) {
-    time_index[columns.timed[k]] = static_cast<int>(k);
-  }
-  for (const double* block : columns.placed) anchor[block] = -1;
-  for (std::size_t r = 0; r + 1 < begin.size(); ++r) {
-    int latest = -1;
-    for (int e = begin[r]; e < begin[r + 1]; ++e) {
-      const auto it = time_index.find(blocks_[e]);
-      if (it != time_index.end()) latest = std::max(latest, it->second);
-    }
-    for (int e = begin[r]; e < begin[r + 1]; ++e) {
-      const auto it = anchor.find(blocks_[e]);
-      if (it != anchor.end()) it->second = std::max(it->second, latest);
-    }
-  }
-  std::vector<std::vector<double*>> after(columns.timed.size() + 1);
-  for (double* block : columns.placed) {
-    after[anchor[block] + 1].push_back(block);
-  }
-  std::vector<double*> order = after[0];
-  for (std::size_t k = 0; k < columns.timed.size(); ++k) {
-    order.push_back(columns.timed[k]);
-    order.insert(order.end(), after[k + 1].begin(), after[k + 1].end());
-  }
-  order.insert(order.end(), columns.last.begin(), columns.last.end());
-  return order;
 }
 
 bool BandedProblem::Evaluate(const Term& term, const Eigen::VectorXd& x,

@@ -25,6 +25,11 @@ struct BandedColumns {
   std::vector<double*> timed, placed, last;
 };
 
+// The blocks of `columns` in the system's column order (as above), placed
+// by the residuals of `problem`.
+std::vector<double*> BandedBlockOrder(const ceres::Problem& problem,
+                                      const BandedColumns& columns);
+
 // The envelope of H in a column order: its columns (the variables), the
 // doubles it stores and the multiply-adds of one factorisation.
 struct BandedSize {
@@ -79,10 +84,6 @@ class BandedProblem {
   };
 
   std::vector<int> EnvelopeFirst() const;
-  // The blocks of `columns` in column order, from the residuals' blocks
-  // (residual r's at blocks_[begin[r]] up to begin[r + 1]).
-  std::vector<double*> ColumnOrder(const BandedColumns& columns,
-                                   const std::vector<int>& begin) const;
   // One term's cost at x and, with `jacobians`, its corrected residual and
   // Jacobian blocks in the buffers below.
   bool Evaluate(const Term& term, const Eigen::VectorXd& x, bool jacobians,

@@ -9,6 +9,7 @@
 #include "ceres/types.h"
 #include "glog/logging.h"
 #include "rff_ceres/banded_minimizer.h"
+#include "rff_ceres/envelope_cholesky.h"
 #include "rff_ceres/io/text_parser.h"
 #include "rff_ceres/linear_system_size.h"
 #include "rff_ceres/option_error.h"
@@ -16,11 +17,6 @@
 
 namespace rff {
 namespace {
-
-// Auto takes BANDED_CHOLESKY up to this many multiply-adds per variable in
-// its factorisation. Measured against CHOLMOD in Ceres (bench/README.md):
-// faster at 220 (Plaza 1's WNOA), slower at 451 (MRCLAM robot 1).
-constexpr double kMaxBandedWorkPerVariable = 300.0;
 
 // Linear solver names are read as Ceres reads its own: in any case.
 bool IsBandedCholesky(std::string name) {
@@ -203,13 +199,13 @@ bool RunSolve(const SolverOptions& solver, ceres::Solver::Options ceres_options,
                       "%.3g GB allowed by --max_memory_gb",
                       bytes / 1e9, limit / 1e9);
         why = text;
-      } else if (!asked && work > kMaxBandedWorkPerVariable) {
+      } else if (!asked && work > kMaxEnvelopeWorkPerVariable) {
         // Landmarks seen over long stretches fill their rows of the factor;
         // a fill-reducing sparse Cholesky then does better.
         std::snprintf(text, sizeof(text),
                       "%.0f multiply-adds per variable in its factorisation, "
                       "more than %.0f",
-                      work, kMaxBandedWorkPerVariable);
+                      work, kMaxEnvelopeWorkPerVariable);
         why = text;
       }
     }

@@ -114,6 +114,32 @@ Eigen::VectorXd EnvelopeMatrix::Solve(const Eigen::VectorXd& b) const {
   return SolveUpper(SolveLower(b));
 }
 
+void EnvelopeMatrix::SolveInPlace(RowMajorMatrix* b) const {
+  CHECK_EQ(b->rows(), size());
+  const int m = static_cast<int>(b->cols());
+  auto b_row = [&](int i) { return b->data() + std::int64_t{i} * m; };
+  for (int i = 0; i < size(); ++i) {  // L Y = B.
+    const double* li = row(i);
+    const int fi = first_[i];
+    double* bi = b_row(i);
+    for (int k = fi; k < i; ++k) {
+      const double* bk = b_row(k);
+      for (int c = 0; c < m; ++c) bi[c] -= li[k - fi] * bk[c];
+    }
+    for (int c = 0; c < m; ++c) bi[c] /= li[i - fi];
+  }
+  for (int i = size() - 1; i >= 0; --i) {  // L^T X = Y.
+    const double* li = row(i);
+    const int fi = first_[i];
+    double* bi = b_row(i);
+    for (int c = 0; c < m; ++c) bi[c] /= li[i - fi];
+    for (int k = fi; k < i; ++k) {
+      double* bk = b_row(k);
+      for (int c = 0; c < m; ++c) bk[c] -= li[k - fi] * bi[c];
+    }
+  }
+}
+
 // L y = b, rows in order.
 Eigen::VectorXd EnvelopeMatrix::SolveLower(const Eigen::VectorXd& b) const {
   Eigen::VectorXd y = b;

@@ -14,6 +14,11 @@
 
 namespace rff {
 
+// Up to this many multiply-adds per variable in Factorize, an envelope
+// beats a fill-reducing sparse Cholesky on our systems; beyond it, long
+// landmark rows fill the envelope (bench/README.md, "BANDED_CHOLESKY").
+constexpr double kMaxEnvelopeWorkPerVariable = 300.0;
+
 class EnvelopeMatrix {
  public:
   // `first[i]` <= i is the first stored column of row i.
@@ -41,6 +46,11 @@ class EnvelopeMatrix {
   Eigen::VectorXd Solve(const Eigen::VectorXd& b) const;
   Eigen::VectorXd SolveLower(const Eigen::VectorXd& b) const;
   Eigen::VectorXd SolveUpper(const Eigen::VectorXd& y) const;
+  // A^-1 B in place for every column of B at once (a row of B contiguous,
+  // L read once); per column the arithmetic of Solve.
+  using RowMajorMatrix =
+      Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  void SolveInPlace(RowMajorMatrix* b) const;
   // The multiply-adds of Factorize on an envelope that starts at `first`.
   static double FactorizationWork(const std::vector<int>& first);
 

@@ -1,9 +1,12 @@
 #include "rff_ceres/gauss_newton_system.h"
 
 #include <algorithm>
+#include <unordered_map>
+#include <utility>
 #include <vector>
 
 #include "Eigen/LU"
+#include "rff_ceres/banded_problem.h"
 
 namespace rff {
 namespace {
@@ -134,6 +137,33 @@ std::vector<double*> LandmarksLast(SlamProblem* problem, int* num_leading) {
   return order;
 }
 
+std::vector<int> TimeOrderPositions(SlamProblem* problem,
+                                    const std::vector<double*>& columns) {
+  std::unordered_map<const double*, int> rank;
+  const std::vector<double*> order =
+      BandedBlockOrder(*problem->problem(), problem->BandColumns());
+  for (std::size_t k = 0; k < order.size(); ++k) {
+    rank[order[k]] = static_cast<int>(k);
+  }
+  std::vector<int> start(columns.size() + 1, 0);  // Of each block's columns.
+  std::vector<int> by_rank(columns.size());
+  for (std::size_t b = 0; b < columns.size(); ++b) {
+    if (rank.count(columns[b]) == 0) return {};
+    start[b + 1] =
+        start[b] + problem->problem()->ParameterBlockSize(columns[b]);
+    by_rank[b] = static_cast<int>(b);
+  }
+  std::sort(by_rank.begin(), by_rank.end(), [&](int a, int b) {
+    return rank.at(columns[a]) < rank.at(columns[b]);
+  });
+  std::vector<int> position(start.back());
+  int next = 0;
+  for (const int b : by_rank) {
+    for (int c = start[b]; c < start[b + 1]; ++c) position[c] = next++;
+  }
+  return position;
+}
+
 bool SchurFormFits(int t, Eigen::Index m) {
   return t >= 1 && t <= kMaxDenseReducedSystem && m % 2 == 0 &&
          double(t) * (t + m) <= kMaxDenseEntries;
@@ -141,11 +171,18 @@ bool SchurFormFits(int t, Eigen::Index m) {
 
 GaussNewtonSystem::GaussNewtonSystem(const RowMajorSparse& jacobian, int t,
                                      Factorization factorization,
-                                     SparseAnalysis* analysis) {
+                                     SparseAnalysis* analysis,
+                                     std::vector<int> time_order)
+    : time_order_(std::move(time_order)) {
+  if (factorization == Factorization::kEnvelopeOrSparse &&
+      FormEnvelope(jacobian)) {
+    return;
+  }
   // A Schur complement singular to rounding is retried as the sparse LDLT
   // (solves only), as is a system without the form.
   const bool sparse_fallback = factorization != Factorization::kSchurOnly;
   if (factorization != Factorization::kSparse &&
+      factorization != Factorization::kEnvelopeOrSparse &&
       SchurFormFits(t, jacobian.cols() - t) && FormSchur(jacobian, t) &&
       (positive_definite_ || !sparse_fallback)) {
     structured_ = true;
@@ -176,6 +213,42 @@ GaussNewtonSystem::GaussNewtonSystem(const RowMajorSparse& jacobian, int t,
   }
   positive_definite_ =
       sparse_->info() == Eigen::Success && sparse_->vectorD().minCoeff() > 0.0;
+}
+
+bool GaussNewtonSystem::FormEnvelope(const RowMajorSparse& j) {
+  const int n = static_cast<int>(j.cols());
+  if (static_cast<int>(time_order_.size()) != n) return false;
+  std::vector<int> first(n);
+  for (int c = 0; c < n; ++c) first[c] = c;
+  for (Eigen::Index r = 0; r < j.rows(); ++r) {
+    int lowest = n;
+    for (RowMajorSparse::InnerIterator it(j, r); it; ++it) {
+      lowest = std::min(lowest, time_order_[it.col()]);
+    }
+    for (RowMajorSparse::InnerIterator it(j, r); it; ++it) {
+      int& f = first[time_order_[it.col()]];
+      f = std::min(f, lowest);
+    }
+  }
+  double entries = 0.0;  // As many doubles as the dense forms may take.
+  for (int i = 0; i < n; ++i) entries += i - first[i] + 1;
+  if (entries > kMaxDenseEntries ||
+      EnvelopeMatrix::FactorizationWork(first) >
+          kMaxEnvelopeWorkPerVariable * std::max(n, 1)) {
+    return false;
+  }
+  envelope_ = std::make_unique<EnvelopeMatrix>(std::move(first));
+  for (Eigen::Index r = 0; r < j.rows(); ++r) {
+    for (RowMajorSparse::InnerIterator a(j, r); a; ++a) {
+      const int pa = time_order_[a.col()];
+      for (RowMajorSparse::InnerIterator b(j, r); b; ++b) {
+        const int pb = time_order_[b.col()];
+        if (pb <= pa) (*envelope_)(pa, pb) += a.value() * b.value();
+      }
+    }
+  }
+  positive_definite_ = envelope_->Factorize();
+  return true;
 }
 
 // False when a row touches two landmarks (not this structure) or a
@@ -242,6 +315,16 @@ Eigen::VectorXd GaussNewtonSystem::ApplyCInverse(
 }
 
 Eigen::MatrixXd GaussNewtonSystem::Solve(const Eigen::MatrixXd& z) const {
+  if (envelope_ != nullptr) {
+    EnvelopeMatrix::RowMajorMatrix x(z.rows(), z.cols());
+    for (Eigen::Index c = 0; c < z.rows(); ++c)
+      x.row(time_order_[c]) = z.row(c);
+    envelope_->SolveInPlace(&x);
+    Eigen::MatrixXd u(z.rows(), z.cols());
+    for (Eigen::Index c = 0; c < z.rows(); ++c)
+      u.row(c) = x.row(time_order_[c]);
+    return u;
+  }
   if (!structured_) return SolveLdltByRows(*sparse_, z);
   const Eigen::Index t = b_.rows(), m = b_.cols();
   Eigen::MatrixXd u(z.rows(), z.cols());

@@ -16,6 +16,7 @@
 #ifndef RFF_CERES_GAUSS_NEWTON_SYSTEM_H_
 #define RFF_CERES_GAUSS_NEWTON_SYSTEM_H_
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -23,6 +24,7 @@
 #include "Eigen/Core"
 #include "Eigen/SparseCholesky"
 #include "Eigen/SparseCore"
+#include "rff_ceres/envelope_cholesky.h"
 #include "rff_ceres/slam_problem.h"
 
 namespace rff {
@@ -33,6 +35,12 @@ using RowMajorSparse = Eigen::SparseMatrix<double, Eigen::RowMajor>;
 // last, in the problem's order; `*num_leading` gets the parameters before
 // them. The column order GaussNewtonSystem expects.
 std::vector<double*> LandmarksLast(SlamProblem* problem, int* num_leading);
+
+// Where each column of a Jacobian over the blocks `columns` goes in the
+// time order of BANDED_CHOLESKY (BandedBlockOrder); empty when `columns`
+// holds a block that order has not.
+std::vector<int> TimeOrderPositions(SlamProblem* problem,
+                                    const std::vector<double*>& columns);
 
 // Whether the Schur form of t leading and m landmark columns fits (sizes
 // only; the structure and conditioning are checked on the Jacobian).
@@ -49,6 +57,11 @@ enum class Factorization {
   // The sparse LDLT (solves only): for banded states (WNOA), whose dense
   // Schur complement would cost t^3 / 3 for what a band does in O(t).
   kSparse,
+  // An envelope Cholesky (envelope_cholesky.h) with the columns in a time
+  // order, where it costs at most kMaxEnvelopeWorkPerVariable per variable:
+  // no symbolic analysis and no fill outside the band (solves only); else
+  // kSparse.
+  kEnvelopeOrSparse,
 };
 
 // The sparse LDLT's symbolic analysis (fill-reducing ordering, elimination
@@ -65,14 +78,18 @@ class GaussNewtonSystem {
   // `jacobian`'s first `t` columns are the leading blocks, the rest the
   // landmarks, two each. With `analysis`, the sparse LDLT is factorised in
   // it, analysed only when H's pattern is not the one it holds; it must
-  // outlive this system and serve one system at a time.
+  // outlive this system and serve one system at a time. kEnvelopeOrSparse
+  // puts column c at `time_order[c]` (TimeOrderPositions).
   GaussNewtonSystem(const RowMajorSparse& jacobian, int t,
                     Factorization factorization,
-                    SparseAnalysis* analysis = nullptr);
+                    SparseAnalysis* analysis = nullptr,
+                    std::vector<int> time_order = {});
 
   // Whether the Schur form was built (covariances are available).
   bool structured() const { return structured_; }
   bool positive_definite() const { return positive_definite_; }
+  // Whether H was factorised as an envelope.
+  bool envelope() const { return envelope_ != nullptr; }
   // H^-1 z, every column of z at once: the sparse factor is read once for
   // all of them, with the same arithmetic as one column at a time.
   Eigen::MatrixXd Solve(const Eigen::MatrixXd& z) const;
@@ -83,6 +100,8 @@ class GaussNewtonSystem {
 
  private:
   bool FormSchur(const RowMajorSparse& jacobian, int t);
+  // False (nothing formed) where the envelope costs too much.
+  bool FormEnvelope(const RowMajorSparse& jacobian);
   Eigen::VectorXd ApplyCInverse(const Eigen::VectorXd& v) const;
 
   bool structured_ = false;
@@ -90,6 +109,8 @@ class GaussNewtonSystem {
   Eigen::MatrixXd b_;
   std::vector<Eigen::Matrix2d> c_inverse_;
   Eigen::LDLT<Eigen::MatrixXd> schur_;
+  std::vector<int> time_order_;
+  std::unique_ptr<EnvelopeMatrix> envelope_;
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> own_sparse_;
   // own_sparse_ or the analysis's.
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>* sparse_ = &own_sparse_;

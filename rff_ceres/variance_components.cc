@@ -69,12 +69,14 @@ bool EstimateVarianceComponents(SlamProblem* problem,
   const std::vector<VarianceGroup> groups = problem->RowGroups(ids);
   CHECK_EQ(static_cast<Eigen::Index>(groups.size()), residuals.size());
   // Only traces and solves are needed: banded states skip the dense Schur
-  // complement their solver does without too (AutoLinearSolverType).
-  const GaussNewtonSystem hessian(jacobian, num_leading,
-                                  problem->model().HasDenseReducedSystem()
-                                      ? Factorization::kSchurOrSparse
-                                      : Factorization::kSparse,
-                                  analysis);
+  // complement their solver does without too (AutoLinearSolverType) and
+  // take the envelope BANDED_CHOLESKY factorises.
+  const bool banded = !problem->model().HasDenseReducedSystem();
+  const GaussNewtonSystem hessian(
+      jacobian, num_leading,
+      banded ? Factorization::kEnvelopeOrSparse : Factorization::kSchurOrSparse,
+      analysis,
+      banded ? TimeOrderPositions(problem, columns) : std::vector<int>());
   if (!hessian.positive_definite()) {
     *error = "the Gauss-Newton Hessian is not positive definite";
     return false;

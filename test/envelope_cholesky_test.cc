@@ -106,6 +106,26 @@ TEST(EnvelopeCholeskyTest, FactorMatchesEigensWithBlocksOfEverySize) {
   }
 }
 
+// Many right-hand sides at once give, column by column, Solve's bits.
+TEST(EnvelopeCholeskyTest, SolveInPlaceGivesSolvesBitsPerColumn) {
+  std::vector<int> first;
+  const Eigen::MatrixXd a = BandedWithBorder(50, 3, 2, &first);
+  EnvelopeMatrix e = FromDense(a, first);
+  ASSERT_TRUE(e.Factorize());
+  std::mt19937 random(9);
+  std::normal_distribution<double> normal;
+  EnvelopeMatrix::RowMajorMatrix b(a.rows(), 5);
+  for (Eigen::Index i = 0; i < b.size(); ++i) b.data()[i] = normal(random);
+  EnvelopeMatrix::RowMajorMatrix x = b;
+  e.SolveInPlace(&x);
+  for (Eigen::Index k = 0; k < b.cols(); ++k) {
+    const Eigen::VectorXd one = e.Solve(b.col(k));
+    for (Eigen::Index i = 0; i < b.rows(); ++i) {
+      ASSERT_EQ(x(i, k), one[i]) << i << ", " << k;
+    }
+  }
+}
+
 TEST(EnvelopeCholeskyTest, RefusesAnIndefiniteOrNonFiniteMatrix) {
   EnvelopeMatrix indefinite({0, 0});
   indefinite(0, 0) = 1.0;

@@ -109,6 +109,70 @@ TEST(GaussNewtonSystemTest, ManyColumnsSolveAsEigenSolvesEach) {
   }
 }
 
+// The envelope in a time order (the chain run backwards, the landmarks,
+// seen all along, after it), against the dense LDLT; the solutions come back
+// in the Jacobian's column order.
+TEST(GaussNewtonSystemTest, EnvelopeInATimeOrderSolvesTheSameSystem) {
+  const int t = 40, landmarks = 3;
+  const RowMajorSparse jacobian = ChainWithLandmarks(t, landmarks, 7);
+  std::vector<int> time_order(t + 2 * landmarks);
+  for (int c = 0; c < t + 2 * landmarks; ++c) {
+    time_order[c] = c < t ? t - 1 - c : c;
+  }
+  const GaussNewtonSystem envelope(
+      jacobian, t, Factorization::kEnvelopeOrSparse, nullptr, time_order);
+  ASSERT_TRUE(envelope.envelope());
+  ASSERT_TRUE(envelope.positive_definite());
+  EXPECT_FALSE(envelope.structured());
+  const Eigen::MatrixXd h = Eigen::MatrixXd(
+      Eigen::SparseMatrix<double>(jacobian.transpose()) * jacobian);
+  Eigen::MatrixXd z(h.rows(), 3);
+  z.col(0) = Eigen::VectorXd::LinSpaced(h.rows(), -1.0, 2.0);
+  z.col(1) = Eigen::VectorXd::Ones(h.rows());
+  z.col(2) = Eigen::VectorXd::LinSpaced(h.rows(), 3.0, -4.0);
+  const Eigen::MatrixXd expected = h.ldlt().solve(z);
+  const Eigen::MatrixXd solved = envelope.Solve(z);
+  for (Eigen::Index k = 0; k < z.cols(); ++k) {
+    const double scale = expected.col(k).cwiseAbs().maxCoeff();
+    EXPECT_LT((solved.col(k) - expected.col(k)).cwiseAbs().maxCoeff(),
+              1e-9 * scale)
+        << k;
+  }
+}
+
+// Where the envelope would cost more than kMaxEnvelopeWorkPerVariable a
+// variable (every row over every column: n^2 / 6), or no time order is
+// given, the sparse LDLT solves.
+TEST(GaussNewtonSystemTest, EnvelopeTooCostlyOrUnorderedFallsBackToSparse) {
+  const int n = 60;  // 600 multiply-adds a variable.
+  std::mt19937 rng(4);
+  std::normal_distribution<double> normal;
+  Eigen::MatrixXd dense(2 * n, n);
+  for (Eigen::Index i = 0; i < dense.size(); ++i) dense.data()[i] = normal(rng);
+  const RowMajorSparse jacobian = dense.sparseView();
+  std::vector<int> identity(n);
+  for (int c = 0; c < n; ++c) identity[c] = c;
+  const GaussNewtonSystem costly(jacobian, n, Factorization::kEnvelopeOrSparse,
+                                 nullptr, identity);
+  const GaussNewtonSystem unordered(jacobian, n,
+                                    Factorization::kEnvelopeOrSparse);
+  const Eigen::VectorXd z = Eigen::VectorXd::LinSpaced(n, -1.0, 2.0);
+  const Eigen::VectorXd expected = (dense.transpose() * dense).ldlt().solve(z);
+  for (const GaussNewtonSystem* system : {&costly, &unordered}) {
+    EXPECT_FALSE(system->envelope());
+    EXPECT_FALSE(system->structured());
+    ASSERT_TRUE(system->positive_definite());
+    EXPECT_LT((system->Solve(z) - expected).cwiseAbs().maxCoeff(),
+              1e-9 * expected.cwiseAbs().maxCoeff());
+  }
+  // At 20 columns (67 a variable) the same shape takes the envelope.
+  const RowMajorSparse small = dense.leftCols(20).sparseView();
+  const GaussNewtonSystem envelope(
+      small, 20, Factorization::kEnvelopeOrSparse, nullptr,
+      std::vector<int>(identity.begin(), identity.begin() + 20));
+  EXPECT_TRUE(envelope.envelope());
+}
+
 // A kept analysis gives the bits a fresh factorisation gives, for systems of
 // its pattern (new values) and of another (analysed again).
 TEST(GaussNewtonSystemTest, KeptAnalysisChangesNoDigit) {
