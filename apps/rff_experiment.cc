@@ -21,6 +21,7 @@
 
 #include "gflags/gflags.h"
 #include "glog/logging.h"
+#include "rff_ceres/allocator.h"
 #include "rff_ceres/experiment/experiment.h"
 #include "rff_ceres/io/flagfile_check.h"
 #include "slam_flags.h"
@@ -104,6 +105,7 @@ std::string FindSourceRoot(const char* argv0) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  rff::RetainFreedMemory();
   FLAGS_logtostderr = true;
   gflags::SetUsageMessage(
       "rff_experiment --out_dir=DIR [--quick] [--methods=rff,wnoa] "

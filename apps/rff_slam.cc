@@ -12,6 +12,7 @@
 
 #include "gflags/gflags.h"
 #include "glog/logging.h"
+#include "rff_ceres/allocator.h"
 #include "rff_ceres/features/feature_map.h"
 #include "rff_ceres/io/dataset_io.h"
 #include "rff_ceres/io/output_file.h"
@@ -45,6 +46,7 @@ int Fail(const std::string& message) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  rff::RetainFreedMemory();
   FLAGS_logtostderr = true;
   gflags::SetUsageMessage(
       "rff_slam --dataset=IN.rffd --output_trajectory=OUT.tum "
