@@ -15,9 +15,11 @@
 namespace rff {
 
 // Up to this many multiply-adds per variable in Factorize, an envelope
-// beats a fill-reducing sparse Cholesky on our systems; beyond it, long
-// landmark rows fill the envelope (bench/README.md, "BANDED_CHOLESKY").
-constexpr double kMaxEnvelopeWorkPerVariable = 300.0;
+// beats a fill-reducing sparse Cholesky on our systems; beyond it, landmarks
+// seen again after long stretches fill the envelope (whole WNOA solves
+// against CHOLMOD: 0.8x at 220-944, 0.13x at 2794; 1.27x at 3313, 2.7x at
+// 13635; bench/README.md, "BANDED_CHOLESKY").
+constexpr double kMaxEnvelopeWorkPerVariable = 3000.0;
 
 class EnvelopeMatrix {
  public:

@@ -118,7 +118,11 @@ bool LearnScales(const Dataset& dataset,
       if (!c.estimated || kept.count(group) > 0) return;
       const double fall = -std::log(c.factor);
       Falls& f = falls[group];
-      f.accelerating = fall > 0.0 && fall >= f.last ? f.accelerating + 1 : 0;
+      // A sigma at its lower bound falls no further: its factors there are
+      // the rounding of residuals near zero, not a trend.
+      const bool at_bound = power < 1.0 && *scale <= 1.0 / kMaxNoiseScale;
+      f.accelerating =
+          !at_bound && fall > 0.0 && fall >= f.last ? f.accelerating + 1 : 0;
       f.last = fall;
       if (power < 1.0 && f.accelerating > kAcceleratingFalls) {
         // A noise sigma falling faster round after round runs to the

@@ -144,7 +144,7 @@ TEST(GaussNewtonSystemTest, EnvelopeInATimeOrderSolvesTheSameSystem) {
 // variable (every row over every column: n^2 / 6), or no time order is
 // given, the sparse LDLT solves.
 TEST(GaussNewtonSystemTest, EnvelopeTooCostlyOrUnorderedFallsBackToSparse) {
-  const int n = 60;  // 600 multiply-adds a variable.
+  const int n = 150;  // 3750 multiply-adds a variable.
   std::mt19937 rng(4);
   std::normal_distribution<double> normal;
   Eigen::MatrixXd dense(2 * n, n);
