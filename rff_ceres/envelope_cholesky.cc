@@ -53,6 +53,15 @@ void EnvelopeMatrix::EliminateRowsAlike(int group, int first) {
 // entries left of the group in one pass, then the group's own triangle.
 bool EnvelopeMatrix::Factorize() {
   constexpr int kMaxRowsAtOnce = 6;
+  using Eliminate = void (EnvelopeMatrix::*)(int, int);
+  static constexpr Eliminate kEliminate[kMaxRowsAtOnce + 1] = {
+      nullptr,
+      &EnvelopeMatrix::EliminateRowsAlike<1>,
+      &EnvelopeMatrix::EliminateRowsAlike<2>,
+      &EnvelopeMatrix::EliminateRowsAlike<3>,
+      &EnvelopeMatrix::EliminateRowsAlike<4>,
+      &EnvelopeMatrix::EliminateRowsAlike<5>,
+      &EnvelopeMatrix::EliminateRowsAlike<6>};
   int end = 0;
   for (int group = 0; group < size(); group = end) {
     const int first = first_[group];
@@ -61,26 +70,7 @@ bool EnvelopeMatrix::Factorize() {
            first_[end] == first) {
       ++end;
     }
-    switch (end - group) {
-      case 1:
-        EliminateRowsAlike<1>(group, first);
-        break;
-      case 2:
-        EliminateRowsAlike<2>(group, first);
-        break;
-      case 3:
-        EliminateRowsAlike<3>(group, first);
-        break;
-      case 4:
-        EliminateRowsAlike<4>(group, first);
-        break;
-      case 5:
-        EliminateRowsAlike<5>(group, first);
-        break;
-      default:
-        EliminateRowsAlike<6>(group, first);
-        break;
-    }
+    (this->*kEliminate[end - group])(group, first);
     for (int i = group; i < end; ++i) {
       double* li = row(i);
       // The group's own triangle: row j of it stores from `first` too.
