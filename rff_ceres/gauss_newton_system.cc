@@ -247,8 +247,11 @@ bool GaussNewtonSystem::FormEnvelope(const RowMajorSparse& j) {
       }
     }
   }
+  // Not positive definite to rounding without pivoting: the sparse LDLT,
+  // in its own order, decides.
   positive_definite_ = envelope_->Factorize();
-  return true;
+  if (!positive_definite_) envelope_.reset();
+  return positive_definite_;
 }
 
 // False when a row touches two landmarks (not this structure) or a

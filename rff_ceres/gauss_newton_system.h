@@ -100,7 +100,8 @@ class GaussNewtonSystem {
 
  private:
   bool FormSchur(const RowMajorSparse& jacobian, int t);
-  // False (nothing formed) where the envelope costs too much.
+  // False (nothing formed) where the envelope costs too much or its
+  // Cholesky finds H not positive definite.
   bool FormEnvelope(const RowMajorSparse& jacobian);
   Eigen::VectorXd ApplyCInverse(const Eigen::VectorXd& v) const;
 

@@ -173,6 +173,20 @@ TEST(GaussNewtonSystemTest, EnvelopeTooCostlyOrUnorderedFallsBackToSparse) {
   EXPECT_TRUE(envelope.envelope());
 }
 
+// A singular H (a column no row touches) fails the envelope's Cholesky;
+// the sparse LDLT then decides, and finds it singular too.
+TEST(GaussNewtonSystemTest, SingularEnvelopeFallsBackAndIsNotPositiveDefinite) {
+  const int t = 12;
+  RowMajorSparse jacobian = ChainWithLandmarks(t, 1, 3);
+  jacobian.conservativeResize(jacobian.rows(), jacobian.cols() + 1);
+  std::vector<int> time_order(jacobian.cols());
+  for (int c = 0; c < jacobian.cols(); ++c) time_order[c] = c;
+  const GaussNewtonSystem system(jacobian, t, Factorization::kEnvelopeOrSparse,
+                                 nullptr, time_order);
+  EXPECT_FALSE(system.envelope());
+  EXPECT_FALSE(system.positive_definite());
+}
+
 // A kept analysis gives the bits a fresh factorisation gives, for systems of
 // its pattern (new values) and of another (analysed again).
 TEST(GaussNewtonSystemTest, KeptAnalysisChangesNoDigit) {
