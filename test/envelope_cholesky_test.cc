@@ -106,6 +106,79 @@ TEST(EnvelopeCholeskyTest, FactorMatchesEigensWithBlocksOfEverySize) {
   }
 }
 
+// A time-ordered system as BANDED_CHOLESKY builds it: states of 3
+// variables, each coupled to the next, and landmarks of 2 seen from
+// overlapping stretches of states, each placed after the last state that
+// sees it: long landmark rows that cross other landmarks' columns.
+TEST(EnvelopeCholeskyTest, FactorMatchesEigensWithLandmarksSeenOverStretches) {
+  const int num_states = 200;
+  const std::vector<std::pair<int, int>> sightings = {
+      {0, 150},  {5, 40},   {10, 120},  {30, 60},   {45, 199},
+      {50, 130}, {90, 100}, {100, 180}, {110, 199}, {160, 190}};
+  // Landmark k's columns come after state sightings[k].second's.
+  std::vector<int> state_column(num_states), landmark_column(sightings.size());
+  int next = 0;
+  for (int s = 0; s < num_states; ++s) {
+    state_column[s] = next;
+    next += 3;
+    for (std::size_t k = 0; k < sightings.size(); ++k) {
+      if (sightings[k].second == s) {
+        landmark_column[k] = next;
+        next += 2;
+      }
+    }
+  }
+  const int n = next;
+  std::mt19937 random(11);
+  std::normal_distribution<double> normal;
+  std::vector<Eigen::VectorXd> rows;
+  auto add_row = [&](const std::vector<int>& columns) {
+    Eigen::VectorXd row = Eigen::VectorXd::Zero(n);
+    for (const int c : columns) row[c] = normal(random);
+    rows.push_back(row);
+  };
+  for (int s = 0; s + 1 < num_states; ++s) {
+    for (int r = 0; r < 4; ++r) {
+      std::vector<int> columns;
+      for (int c = 0; c < 3; ++c) {
+        columns.push_back(state_column[s] + c);
+        columns.push_back(state_column[s + 1] + c);
+      }
+      add_row(columns);
+    }
+  }
+  for (std::size_t k = 0; k < sightings.size(); ++k) {
+    for (int s = sightings[k].first; s <= sightings[k].second; s += 3) {
+      for (int r = 0; r < 2; ++r) {
+        add_row({state_column[s], state_column[s] + 1, state_column[s] + 2,
+                 landmark_column[k], landmark_column[k] + 1});
+      }
+    }
+  }
+  Eigen::MatrixXd j(rows.size(), n);
+  for (std::size_t r = 0; r < rows.size(); ++r) j.row(r) = rows[r];
+  const Eigen::MatrixXd a = j.transpose() * j;
+  std::vector<int> first(n);
+  int long_rows = 0;
+  for (int i = 0; i < n; ++i) {
+    int f = 0;
+    while (a(i, f) == 0.0) ++f;
+    first[i] = f;
+    if (i - f >= 64) ++long_rows;
+  }
+  EXPECT_GE(long_rows, 12);
+  EnvelopeMatrix e = FromDense(a, first);
+  ASSERT_TRUE(e.Factorize());
+  const Eigen::MatrixXd l = a.llt().matrixL();
+  const double tolerance = 1e-11 * l.norm();
+  for (int i = 0; i < n; ++i) {
+    for (int k = 0; k <= i; ++k) {
+      const double entry = k >= first[i] ? e(i, k) : 0.0;
+      ASSERT_NEAR(entry, l(i, k), tolerance) << i << ", " << k;
+    }
+  }
+}
+
 // Many right-hand sides at once give, column by column, Solve's bits.
 TEST(EnvelopeCholeskyTest, SolveInPlaceGivesSolvesBitsPerColumn) {
   std::vector<int> first;
