@@ -101,6 +101,20 @@ bool LearnScales(const Dataset& dataset,
   std::set<VarianceGroup> learned;  // Noise factors the data estimated.
   const ceres::Solver::Options placing_options = PlacingOptions(ceres_options);
   SparseAnalysis analysis;  // The rounds' problems share one structure.
+  // The largest trust radius the solves reached: after rounds, the final
+  // solve goes on from their point on their problem but for a rescale, so
+  // it starts as trusting as they became (from the initial radius
+  // Levenberg-Marquardt needs a dozen steps, tripling, to stop damping the
+  // weak directions). Without rounds it finishes the first solve as a run
+  // without learning would.
+  double reached_radius = ceres_options.initial_trust_region_radius;
+  bool rounds_solved = false;
+  auto note_radius = [&] {
+    for (const ceres::IterationSummary& it : result->summary.iterations) {
+      reached_radius = std::max(reached_radius, it.trust_region_radius);
+    }
+  };
+  note_radius();
   for (int round = 0; round < kMaxScaleRounds; ++round) {
     VarianceComponents components;
     std::string why;
@@ -180,6 +194,8 @@ bool LearnScales(const Dataset& dataset,
                     initial_extent, problem, result, error)) {
       return false;
     }
+    note_radius();
+    rounds_solved = true;
     result->learned = true;
     loose = true;
   }
@@ -189,8 +205,13 @@ bool LearnScales(const Dataset& dataset,
     }
   }
   // The rounds' solves only placed the next factors.
+  ceres::Solver::Options final_options = ceres_options;
+  if (rounds_solved) {
+    final_options.initial_trust_region_radius =
+        std::min(reached_radius, ceres_options.max_trust_region_radius);
+  }
   return !loose ||
-         SolveBatch(dataset, *settled, ceres_options, model->get(), landmarks,
+         SolveBatch(dataset, *settled, final_options, model->get(), landmarks,
                     initial_extent, problem, result, error);
 }
 
