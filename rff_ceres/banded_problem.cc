@@ -86,6 +86,8 @@ BandedProblem::BandedProblem(const ceres::Problem& problem,
     term.blocks = blocks_.data() + begin[r];
     term.column = columns_.data() + begin[r];
     term.size = sizes_.data() + begin[r];
+    term.first_row = num_rows_;
+    num_rows_ += term.cost->num_residuals();
     const bool variable =
         std::any_of(term.column, term.column + term.num_blocks,
                     [](int c) { return c >= 0; });
@@ -170,6 +172,38 @@ bool BandedProblem::Linearize(const Eigen::VectorXd& x, double* cost,
     if (!Evaluate(term, x, /*jacobians=*/true, &term_cost)) return false;
     *cost += term_cost;
     Accumulate(term, g, h);
+  }
+  return true;
+}
+
+bool BandedProblem::RowProducts(const Eigen::VectorXd& x,
+                                const EnvelopeMatrix::RowMajorMatrix& z,
+                                const EnvelopeMatrix::RowMajorMatrix& u,
+                                Eigen::VectorXd* residuals,
+                                Eigen::VectorXd* products) {
+  residuals->setZero(num_rows_);
+  products->setZero(num_rows_);
+  Eigen::RowVectorXd jz(z.cols()), ju(u.cols());
+  for (const std::vector<Term>* terms : {&terms_, &fixed_terms_}) {
+    for (const Term& term : *terms) {
+      double term_cost;
+      if (!Evaluate(term, x, /*jacobians=*/true, &term_cost)) return false;
+      const int rows = static_cast<int>(residual_buffer_.size());
+      for (int k = 0; k < rows; ++k) {
+        (*residuals)[term.first_row + k] = residual_buffer_[k];
+        jz.setZero();
+        ju.setZero();
+        for (int a = 0; a < term.num_blocks; ++a) {
+          if (term.column[a] < 0) continue;
+          const double* j = jacobian_rows_[a].data() + k * term.size[a];
+          for (int i = 0; i < term.size[a]; ++i) {
+            jz += j[i] * z.row(term.column[a] + i);
+            ju += j[i] * u.row(term.column[a] + i);
+          }
+        }
+        (*products)[term.first_row + k] = jz.dot(ju);
+      }
+    }
   }
   return true;
 }

@@ -69,6 +69,17 @@ class BandedProblem {
   // 4.3, clamped as Ceres's Corrector clamps it where rho'' <= 0).
   bool Linearize(const Eigen::VectorXd& x, double* cost, Eigen::VectorXd* g,
                  EnvelopeMatrix* h);
+  // The residual rows of the problem, its residual blocks in order (the
+  // fixed cost's too).
+  int num_rows() const { return num_rows_; }
+  // At x, per residual row: the residual as its loss corrects it, and the
+  // row's share of tr(U^T J^T J Z), sum_p (J z_p)_row (J u_p)_row over the
+  // columns of `z` and `u` (num_columns() rows each; 0 on fixed rows). One
+  // pass over the terms, no Jacobian kept. False as Cost.
+  bool RowProducts(const Eigen::VectorXd& x,
+                   const EnvelopeMatrix::RowMajorMatrix& z,
+                   const EnvelopeMatrix::RowMajorMatrix& u,
+                   Eigen::VectorXd* residuals, Eigen::VectorXd* products);
 
  private:
   // One residual block: its cost, loss and parameter blocks, each with its
@@ -81,6 +92,7 @@ class BandedProblem {
     double* const* blocks = nullptr;
     const int* column = nullptr;
     const int* size = nullptr;
+    int first_row = 0;  // Among the problem's residual rows.
   };
 
   std::vector<int> EnvelopeFirst() const;
@@ -99,6 +111,7 @@ class BandedProblem {
   std::vector<int> columns_, sizes_;
   std::vector<Term> terms_, fixed_terms_;
   int num_columns_ = 0;
+  int num_rows_ = 0;
   std::vector<int> envelope_first_;
   std::vector<const double*> parameters_;
   std::vector<std::vector<double>> jacobian_rows_;

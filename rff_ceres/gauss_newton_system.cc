@@ -164,6 +164,12 @@ std::vector<int> TimeOrderPositions(SlamProblem* problem,
   return position;
 }
 
+bool EnvelopeAffordable(const BandedSize& size) {
+  return static_cast<double>(size.entries) <= kMaxDenseEntries &&
+         size.multiply_adds <=
+             kMaxEnvelopeWorkPerVariable * std::max(size.num_columns, 1);
+}
+
 bool SchurFormFits(int t, Eigen::Index m) {
   return t >= 1 && t <= kMaxDenseReducedSystem && m % 2 == 0 &&
          double(t) * (t + m) <= kMaxDenseEntries;
@@ -230,13 +236,11 @@ bool GaussNewtonSystem::FormEnvelope(const RowMajorSparse& j) {
       f = std::min(f, lowest);
     }
   }
-  double entries = 0.0;  // As many doubles as the dense forms may take.
-  for (int i = 0; i < n; ++i) entries += i - first[i] + 1;
-  if (entries > kMaxDenseEntries ||
-      EnvelopeMatrix::FactorizationWork(first) >
-          kMaxEnvelopeWorkPerVariable * std::max(n, 1)) {
-    return false;
-  }
+  BandedSize size;
+  size.num_columns = n;
+  for (int i = 0; i < n; ++i) size.entries += i - first[i] + 1;
+  size.multiply_adds = EnvelopeMatrix::FactorizationWork(first);
+  if (!EnvelopeAffordable(size)) return false;
   envelope_ = std::make_unique<EnvelopeMatrix>(std::move(first));
   for (Eigen::Index r = 0; r < j.rows(); ++r) {
     for (RowMajorSparse::InnerIterator a(j, r); a; ++a) {

@@ -24,6 +24,7 @@
 #include "Eigen/Core"
 #include "Eigen/SparseCholesky"
 #include "Eigen/SparseCore"
+#include "rff_ceres/banded_problem.h"
 #include "rff_ceres/envelope_cholesky.h"
 #include "rff_ceres/slam_problem.h"
 
@@ -45,6 +46,11 @@ std::vector<int> TimeOrderPositions(SlamProblem* problem,
 // Whether the Schur form of t leading and m landmark columns fits (sizes
 // only; the structure and conditioning are checked on the Jacobian).
 bool SchurFormFits(int t, Eigen::Index m);
+
+// Whether H is factorised in an envelope of `size` for solves: it fits the
+// memory of the dense forms and costs at most kMaxEnvelopeWorkPerVariable
+// per variable.
+bool EnvelopeAffordable(const BandedSize& size);
 
 // How a GaussNewtonSystem is factorised.
 enum class Factorization {

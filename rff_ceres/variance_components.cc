@@ -6,6 +6,8 @@
 
 #include "ceres/crs_matrix.h"
 #include "glog/logging.h"
+#include "rff_ceres/banded_minimizer.h"
+#include "rff_ceres/banded_problem.h"
 #include "rff_ceres/gauss_newton_system.h"
 
 namespace rff {
@@ -50,27 +52,105 @@ bool Linearize(ceres::Problem* problem,
   return true;
 }
 
-bool EstimateVarianceComponents(SlamProblem* problem,
-                                const VarianceComponentOptions& options,
-                                VarianceComponents* components,
-                                std::string* error, SparseAnalysis* analysis) {
-  *components = VarianceComponents();
-  std::vector<ceres::ResidualBlockId> ids;
-  problem->problem()->GetResidualBlocks(&ids);
+namespace {
+
+using RowMajorDense =
+    Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+
+// Probes per pass: a pass holds `rows` times its probes twice, at most
+// 2^22 doubles each, and at most `most` probes.
+int ProbesPerPass(Eigen::Index rows, int most) {
+  constexpr Eigen::Index kMaxBatchEntries = Eigen::Index{1} << 22;
+  return static_cast<int>(std::clamp<Eigen::Index>(
+      kMaxBatchEntries / std::max<Eigen::Index>(rows, 1), 1, most));
+}
+
+// `count` Rademacher probes over `n` columns, drawn probe by probe.
+Eigen::MatrixXd DrawProbes(Eigen::Index n, int count, std::mt19937* engine) {
+  Eigen::MatrixXd z(n, count);
+  // One bit per draw, without a branch: the bit is a coin flip the branch
+  // predictor would miss half the time.
+  for (int probe = 0; probe < count; ++probe) {
+    for (Eigen::Index i = 0; i < n; ++i) {
+      z(i, probe) =
+          static_cast<double>(2 * static_cast<int>((*engine)() & 1u) - 1);
+    }
+  }
+  return z;
+}
+
+// The rows' residuals and the groups' traces tr(H^-1 J_g^T J_g) summed
+// over the probes, through the time-ordered envelope BANDED_CHOLESKY
+// factorises: H from the residual blocks themselves, J z and J H^-1 z term
+// by term, nothing stored per row of J. Probes are drawn over the columns
+// `ll_columns` (LandmarksLast) as the sparse path draws them, so both see
+// the same probes. False before drawing any where the envelope does not
+// serve (bounds, manifolds, constant blocks, too costly, or H not positive
+// definite to rounding): the sparse path decides then. `traces` is written
+// only on success.
+bool BandedTraces(SlamProblem* problem, const std::vector<double*>& ll_columns,
+                  const std::vector<VarianceGroup>& groups,
+                  const VarianceComponentOptions& options, std::mt19937* engine,
+                  Eigen::VectorXd* residuals,
+                  std::array<double, kNumVarianceGroups>* traces) {
+  const BandedColumns columns = problem->BandColumns();
+  std::string why;
+  if (!BandedSolvable(*problem->problem(), columns, &why)) return false;
+  BandedProblem banded(*problem->problem(), columns);
+  const std::vector<int> position = TimeOrderPositions(problem, ll_columns);
+  const int n = banded.num_columns();
+  if (static_cast<int>(position.size()) != n ||
+      banded.num_rows() != static_cast<int>(groups.size()) ||
+      !EnvelopeAffordable(banded.Size())) {
+    return false;
+  }
+  const Eigen::VectorXd x = banded.Gather();
+  EnvelopeMatrix hessian(banded.envelope_first());
+  double cost;
+  Eigen::VectorXd gradient;
+  if (!banded.Linearize(x, &cost, &gradient, &hessian) ||
+      !hessian.Factorize()) {
+    return false;
+  }
+  const int per_pass = ProbesPerPass(n, options.probes);
+  Eigen::VectorXd products;
+  std::array<double, kNumVarianceGroups> sums{};
+  for (int first = 0; first < options.probes; first += per_pass) {
+    const int count = std::min(per_pass, options.probes - first);
+    const Eigen::MatrixXd drawn = DrawProbes(n, count, engine);
+    EnvelopeMatrix::RowMajorMatrix z(n, count);
+    for (int c = 0; c < n; ++c) z.row(position[c]) = drawn.row(c);
+    EnvelopeMatrix::RowMajorMatrix u = z;
+    hessian.SolveInPlace(&u);
+    if (!banded.RowProducts(x, z, u, residuals, &products)) return false;
+    for (Eigen::Index r = 0; r < products.size(); ++r) {
+      sums[static_cast<int>(groups[r])] += products[r];
+    }
+  }
+  *traces = sums;
+  return true;
+}
+
+// The same through the problem's sparse Jacobian and a GaussNewtonSystem
+// (any model; `analysis` kept between calls).
+bool SparseTraces(SlamProblem* problem, const std::vector<double*>& columns,
+                  int num_leading,
+                  const std::vector<ceres::ResidualBlockId>& ids,
+                  const std::vector<VarianceGroup>& groups,
+                  const VarianceComponentOptions& options,
+                  SparseAnalysis* analysis, std::mt19937* engine,
+                  Eigen::VectorXd* residuals,
+                  std::array<double, kNumVarianceGroups>* traces,
+                  std::string* error) {
   double cost = 0.0;
-  Eigen::VectorXd residuals;
   Eigen::SparseMatrix<double, Eigen::RowMajor> jacobian;
-  int num_leading = 0;
-  const std::vector<double*> columns = LandmarksLast(problem, &num_leading);
-  if (!Linearize(problem->problem(), ids, &cost, &residuals, &jacobian, error,
+  if (!Linearize(problem->problem(), ids, &cost, residuals, &jacobian, error,
                  columns)) {
     return false;
   }
-  const std::vector<VarianceGroup> groups = problem->RowGroups(ids);
-  CHECK_EQ(static_cast<Eigen::Index>(groups.size()), residuals.size());
+  CHECK_EQ(static_cast<Eigen::Index>(groups.size()), residuals->size());
   // Only traces and solves are needed: banded states skip the dense Schur
-  // complement their solver does without too (AutoLinearSolverType) and
-  // take the envelope BANDED_CHOLESKY factorises.
+  // complement their solver does without too (AutoLinearSolverType).
   const bool banded = !problem->model().HasDenseReducedSystem();
   const GaussNewtonSystem hessian(
       jacobian, num_leading,
@@ -81,34 +161,44 @@ bool EstimateVarianceComponents(SlamProblem* problem,
     *error = "the Gauss-Newton Hessian is not positive definite";
     return false;
   }
-
-  std::array<double, kNumVarianceGroups> traces{};
-  std::mt19937 engine(options.seed);
-  // Probes in batches: one pass over J and the factor per batch. A batch
-  // holds J's rows times its probes twice: at most 2^22 doubles each.
-  constexpr Eigen::Index kMaxBatchEntries = Eigen::Index{1} << 22;
-  const int per_pass = static_cast<int>(std::clamp<Eigen::Index>(
-      kMaxBatchEntries / std::max<Eigen::Index>(jacobian.rows(), 1), 1, 8));
-  using RowMajorDense =
-      Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  // Probes in batches: one pass over J and the factor per batch.
+  const int per_pass = ProbesPerPass(jacobian.rows(), 8);
   for (int first = 0; first < options.probes; first += per_pass) {
     const int count = std::min(per_pass, options.probes - first);
-    Eigen::MatrixXd z(jacobian.cols(), count);
-    // Rademacher signs from one bit per draw, without a branch: the bit is
-    // a coin flip the branch predictor would miss half the time.
-    for (int probe = 0; probe < count; ++probe) {
-      for (Eigen::Index i = 0; i < z.rows(); ++i) {
-        z(i, probe) =
-            static_cast<double>(2 * static_cast<int>(engine() & 1u) - 1);
-      }
-    }
+    const Eigen::MatrixXd z = DrawProbes(jacobian.cols(), count, engine);
     const RowMajorDense jz = jacobian * RowMajorDense(z);
     const RowMajorDense ju = jacobian * RowMajorDense(hessian.Solve(z));
     for (int probe = 0; probe < count; ++probe) {
       for (Eigen::Index r = 0; r < jz.rows(); ++r) {
-        traces[static_cast<int>(groups[r])] += jz(r, probe) * ju(r, probe);
+        (*traces)[static_cast<int>(groups[r])] += jz(r, probe) * ju(r, probe);
       }
     }
+  }
+  return true;
+}
+
+}  // namespace
+
+bool EstimateVarianceComponents(SlamProblem* problem,
+                                const VarianceComponentOptions& options,
+                                VarianceComponents* components,
+                                std::string* error, SparseAnalysis* analysis) {
+  *components = VarianceComponents();
+  std::vector<ceres::ResidualBlockId> ids;
+  problem->problem()->GetResidualBlocks(&ids);
+  const std::vector<VarianceGroup> groups = problem->RowGroups(ids);
+  int num_leading = 0;
+  const std::vector<double*> columns = LandmarksLast(problem, &num_leading);
+  std::array<double, kNumVarianceGroups> traces{};
+  std::mt19937 engine(options.seed);
+  Eigen::VectorXd residuals;
+  const bool banded = !problem->model().HasDenseReducedSystem() &&
+                      BandedTraces(problem, columns, groups, options, &engine,
+                                   &residuals, &traces);
+  if (!banded &&
+      !SparseTraces(problem, columns, num_leading, ids, groups, options,
+                    analysis, &engine, &residuals, &traces, error)) {
+    return false;
   }
   for (Eigen::Index r = 0; r < residuals.size(); ++r) {
     VarianceComponent& c = (*components)[static_cast<int>(groups[r])];

@@ -11,7 +11,9 @@
 // prior's scale it is MacKay's 1992 fixed point gamma). Iterating solve and
 // rescale maximises the Laplace evidence over the scales. The traces come
 // from Hutchinson's estimator tr(A) = E[z^T A z] with seeded Rademacher
-// probes and one sparse solve each.
+// probes and one solve each: for banded states in the time-ordered
+// envelope BANDED_CHOLESKY factorises, J z term by term; else through the
+// sparse Jacobian.
 #ifndef RFF_CERES_VARIANCE_COMPONENTS_H_
 #define RFF_CERES_VARIANCE_COMPONENTS_H_
 

@@ -12,6 +12,7 @@
 #include "Eigen/Dense"
 #include "ceres/solver.h"
 #include "gtest/gtest.h"
+#include "rff_ceres/banded_problem.h"
 #include "rff_ceres/io/text_parser.h"
 #include "rff_ceres/landmark_init.h"
 #include "rff_ceres/mean/prior_mean.h"
@@ -351,12 +352,73 @@ void ExpectRedundanciesMatchTheExactTraces(const SlamOptions& given) {
   EXPECT_EQ(components[static_cast<int>(VarianceGroup::kFixed)].factor, 1.0);
 }
 
-// WNOA rows touch one or two states: the Schur complement's A = J_t^T J_t
-// by the sparse product.
+// WNOA states: the probes go through the time-ordered envelope, J z term by
+// term (BandedProblem::RowProducts).
 TEST(VarianceComponentsTest, RedundanciesMatchTheExactTracesWnoa) {
   SlamOptions options;
   options.prior = "wnoa";
   ExpectRedundanciesMatchTheExactTraces(options);
+}
+
+// The banded path's per-row residuals and probe products are those of the
+// problem's own Jacobian (Ceres's, through the Cauchy loss's correction),
+// its columns in the envelope's time order.
+TEST(VarianceComponentsTest, BandedRowProductsAreThoseOfTheJacobian) {
+  const Dataset dataset = WnoaDraw(3, 40, 0.05, 0.01);
+  SlamOptions options;
+  options.prior = "wnoa";
+  std::unique_ptr<TrajectoryModel> model;
+  ModelAboutAConstantMean(dataset, options, &model);
+  ASSERT_NE(model, nullptr);
+  std::map<LandmarkId, Eigen::Vector2d> landmarks =
+      TrueLandmarks(dataset, Eigen::Vector2d::Zero());
+  for (auto& [id, position] : landmarks) position += Eigen::Vector2d(0.3, -0.2);
+  std::string error;
+  options.problem.loss = {"cauchy", 0.5};  // Outliers: the clamped branch.
+  SlamProblem problem(model.get(), options.problem);
+  ASSERT_TRUE(problem.Build(dataset, landmarks, &error)) << error;
+
+  std::vector<ceres::ResidualBlockId> ids;
+  problem.problem()->GetResidualBlocks(&ids);
+  int num_leading = 0;
+  const std::vector<double*> columns = LandmarksLast(&problem, &num_leading);
+  double cost = 0.0;
+  Eigen::VectorXd residuals;
+  Eigen::SparseMatrix<double, Eigen::RowMajor> sparse;
+  ASSERT_TRUE(Linearize(problem.problem(), ids, &cost, &residuals, &sparse,
+                        &error, columns));
+  const Eigen::MatrixXd j = sparse;
+  const std::vector<int> position = TimeOrderPositions(&problem, columns);
+  ASSERT_EQ(position.size(), static_cast<std::size_t>(j.cols()));
+
+  BandedProblem banded(*problem.problem(), problem.BandColumns());
+  ASSERT_EQ(banded.num_columns(), j.cols());
+  ASSERT_EQ(banded.num_rows(), j.rows());
+  std::mt19937 engine(7);
+  std::normal_distribution<double> normal;
+  Eigen::MatrixXd z(j.cols(), 3), u(j.cols(), 3);
+  for (Eigen::Index i = 0; i < z.size(); ++i) {
+    z.data()[i] = normal(engine);
+    u.data()[i] = normal(engine);
+  }
+  EnvelopeMatrix::RowMajorMatrix z_banded(j.cols(), 3), u_banded(j.cols(), 3);
+  for (Eigen::Index c = 0; c < j.cols(); ++c) {
+    z_banded.row(position[c]) = z.row(c);
+    u_banded.row(position[c]) = u.row(c);
+  }
+  Eigen::VectorXd banded_residuals, products;
+  ASSERT_TRUE(banded.RowProducts(banded.Gather(), z_banded, u_banded,
+                                 &banded_residuals, &products));
+  const Eigen::MatrixXd jz = j * z, ju = j * u;
+  int outliers = 0;
+  for (Eigen::Index r = 0; r < j.rows(); ++r) {
+    EXPECT_NEAR(banded_residuals[r], residuals[r], 1e-12) << "row " << r;
+    const double expected = jz.row(r).dot(ju.row(r));
+    EXPECT_NEAR(products[r], expected, 1e-10 * (1.0 + std::abs(expected)))
+        << "row " << r;
+    outliers += std::abs(residuals[r]) > 0.5;
+  }
+  EXPECT_GT(outliers, 10);  // The correction was exercised.
 }
 
 // One global feature map: every row is dense over the 3 x 20 weights, so
