@@ -195,7 +195,9 @@ TEST(ExactGpMapTest, SmallDrawBeatsTheLandmarkPriors) {
 
 // The feature trajectory with the true kernel, ample features (one global
 // Hilbert basis) and no learning solves the same model as the exact GP with
-// the "constant" mean: the two MAPs agree to well under a centimetre.
+// the "constant" mean: the two MAPs agree to well under a centimetre, and
+// their Laplace covariances pose by pose to 10% (the xy block in the
+// Frobenius norm, the heading variance).
 struct MatchCase {
   std::string kernel;
   std::uint64_t seed;
@@ -203,10 +205,11 @@ struct MatchCase {
 
 class RffMatchesExactMapTest : public ::testing::TestWithParam<MatchCase> {};
 
-TEST_P(RffMatchesExactMapTest, ApeWithinOneCentimetre) {
+TEST_P(RffMatchesExactMapTest, MapAndCovarianceAgree) {
   const MatchCase& c = GetParam();
   const Dataset dataset = SmallDraw(c.seed, /*num_steps=*/150, c.kernel);
-  const ExactGpOptions exact_options = TruthOptions(dataset, "constant");
+  ExactGpOptions exact_options = TruthOptions(dataset, "constant");
+  exact_options.compute_covariance = true;
   ExactGpResult exact;
   Evaluation exact_evaluation;
   std::string error;
@@ -232,6 +235,7 @@ TEST_P(RffMatchesExactMapTest, ApeWithinOneCentimetre) {
   options.solver.function_tolerance = 1e-14;
   options.solver.gradient_tolerance = 1e-12;
   options.solver.parameter_tolerance = 1e-12;
+  options.output.covariance = true;
   SlamResult rff;
   ASSERT_TRUE(RunSlam(dataset, options, &rff, &error)) << error;
   Evaluation rff_evaluation;
@@ -250,6 +254,34 @@ TEST_P(RffMatchesExactMapTest, ApeWithinOneCentimetre) {
                      exact_evaluation.ape_translation.rms),
             0.01);
   EXPECT_LT(difference, 0.01);
+
+  std::map<double, const Eigen::Matrix3d*> exact_covariance;
+  for (std::size_t i = 0; i < exact.trajectory.size(); ++i) {
+    exact_covariance[exact.trajectory[i].t] = &exact.pose_covariances[i];
+  }
+  ASSERT_EQ(rff.pose_covariances.size(), rff.trajectory.size());
+  int compared = 0;
+  double worst_position = 0.0, worst_heading = 0.0;
+  for (std::size_t i = 0; i < rff.trajectory.size(); ++i) {
+    const auto it = exact_covariance.find(rff.trajectory[i].t);
+    if (it == exact_covariance.end()) continue;
+    ++compared;
+    const Eigen::Matrix2d e = it->second->topLeftCorner<2, 2>();
+    const Eigen::Matrix2d r = rff.pose_covariances[i].topLeftCorner<2, 2>();
+    worst_position = std::max(worst_position, (r - e).norm() / e.norm());
+    const double e_heading = (*it->second)(2, 2);
+    worst_heading = std::max(
+        worst_heading,
+        std::abs(rff.pose_covariances[i](2, 2) - e_heading) / e_heading);
+  }
+  std::printf(
+      "%s seed %llu: %d poses, largest relative covariance "
+      "difference %.4f (xy), %.4f (heading)\n",
+      c.kernel.c_str(), static_cast<unsigned long long>(c.seed), compared,
+      worst_position, worst_heading);
+  EXPECT_EQ(compared, static_cast<int>(exact.trajectory.size()));
+  EXPECT_LT(worst_position, 0.10);
+  EXPECT_LT(worst_heading, 0.10);
 }
 
 INSTANTIATE_TEST_SUITE_P(
