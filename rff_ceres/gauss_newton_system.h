@@ -123,6 +123,15 @@ class GaussNewtonSystem {
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>* sparse_ = &own_sparse_;
 };
 
+// H of `jacobian`, the Jacobian of `problem` over `columns` (LandmarksLast,
+// `num_leading` before the landmarks), factorised for solves as the
+// model's structure asks: banded states in the time-ordered envelope,
+// others in the Schur form, either as the sparse LDLT where it does not
+// serve.
+std::unique_ptr<GaussNewtonSystem> SystemForSolves(
+    SlamProblem* problem, const RowMajorSparse& jacobian, int num_leading,
+    const std::vector<double*>& columns, SparseAnalysis* analysis = nullptr);
+
 }  // namespace rff
 
 #endif  // RFF_CERES_GAUSS_NEWTON_SYSTEM_H_

@@ -48,9 +48,18 @@ QualityReport AssessQuality(
     const std::map<std::string, std::vector<double>>& residuals,
     const SolveFacts& facts) {
   QualityReport report;
+  report.predicted_decrease = facts.predicted_decrease;
   if (!facts.converged) {
     report.reasons.push_back("the solver stopped before convergence (" +
                              facts.termination + ")");
+  }
+  if (facts.predicted_decrease > kMaxPredictedDecrease) {
+    report.reasons.push_back(
+        "the Gauss-Newton model still expects the cost to fall by " +
+        Short(facts.predicted_decrease) + " (more than " +
+        Short(kMaxPredictedDecrease) +
+        "): the solve stopped short of its "
+        "minimum");
   }
   for (const auto& [kind, values] : residuals) {
     if (values.empty()) continue;

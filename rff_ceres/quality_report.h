@@ -28,6 +28,10 @@ inline constexpr double kMaxShareBeyond3Sigma = 0.05;
 // A few outliers among a few residuals are chance: the share counts only
 // when that many beyond 3 sigma would be rarer than this under N(0, 1).
 inline constexpr double kOutlierCountProbability = 1e-3;
+// A minimum leaves the Gauss-Newton model nothing to gain: a solve that
+// "converged" with more than this (half a chi-square unit on each of two
+// parameters' worth) still ahead stopped on a flat step short of it.
+inline constexpr double kMaxPredictedDecrease = 1.0;
 
 // The |r| that n draws of N(0, 1) all stay within with probability
 // 1 - kOutlierCountProbability (n * P(|r| > level) = that probability): a
@@ -48,6 +52,7 @@ struct QualityReport {
   std::vector<ResidualKindQuality> kinds;  // Sorted by kind.
   std::string verdict = "ok";              // "ok" or "suspect"
   std::vector<std::string> reasons;        // Why "suspect", one line each.
+  double predicted_decrease = 0.0;         // SolveFacts's, NaN if unknown.
   bool suspect() const { return verdict != "ok"; }
 };
 
@@ -55,6 +60,10 @@ struct QualityReport {
 struct SolveFacts {
   bool converged = true;  // Ceres reported CONVERGENCE.
   std::string termination;
+  // The cost the Gauss-Newton model still expects to gain at the solution,
+  // g^T H^-1 g / 2; NaN where it is not known (H not positive definite,
+  // incremental updates).
+  double predicted_decrease = 0.0;
   // Range self-calibration: (scale, offset), (1, 0) when not estimated, and
   // whether a bound of slam_problem.h holds it.
   Eigen::Vector2d range_calibration = Eigen::Vector2d(1.0, 0.0);

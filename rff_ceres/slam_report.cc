@@ -1,6 +1,7 @@
 #include "rff_ceres/slam_report.h"
 
 #include <algorithm>
+#include <cmath>
 #include <functional>
 #include <memory>
 #include <string>
@@ -228,6 +229,12 @@ void WriteSummaryJson(const SlamOptions& options, const SlamResult& result,
       << FormatNumber(result.odometry_calibration[1]) << ",\n"
       << "  \"quality\": " << JsonString(result.quality.verdict) << ",\n"
       << "  \"quality_reasons\": " << JsonStringArray(result.quality.reasons)
+      << ",\n"
+      // null where not known (H not positive definite, incremental).
+      << "  \"predicted_decrease\": "
+      << (std::isfinite(result.quality.predicted_decrease)
+              ? FormatNumber(result.quality.predicted_decrease)
+              : "null")
       << ",\n  \"residuals\": {";
   for (std::size_t i = 0; i < result.quality.kinds.size(); ++i) {
     const ResidualKindQuality& q = result.quality.kinds[i];

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <set>
 #include <utility>
 
@@ -10,6 +11,7 @@
 #include "glog/logging.h"
 #include "rff_ceres/batch_solver.h"
 #include "rff_ceres/dead_reckoning.h"
+#include "rff_ceres/gauss_newton_system.h"
 #include "rff_ceres/incremental_solver.h"
 #include "rff_ceres/initialization.h"
 #include "rff_ceres/landmark_init.h"
@@ -17,6 +19,7 @@
 #include "rff_ceres/priors/trajectory_prior.h"
 #include "rff_ceres/scale_learning.h"
 #include "rff_ceres/solve_start.h"
+#include "rff_ceres/variance_components.h"
 
 namespace rff {
 
@@ -57,6 +60,32 @@ SolveFacts SolveFactsOf(const SlamOptions& options, const SlamResult& result) {
       result.odometry_calibration.minCoeff() < kMinOdometryScale + kAtBound ||
       result.odometry_calibration.maxCoeff() > kMaxOdometryScale - kAtBound;
   return facts;
+}
+
+// g^T H^-1 g / 2 at the problem's values, g = J^T r and H = J^T J of its
+// whitened, loss-corrected residuals: what the Gauss-Newton model still
+// expects to gain (SolveFacts::predicted_decrease); NaN where H is not
+// positive definite.
+double PredictedDecrease(SlamProblem* problem) {
+  std::vector<ceres::ResidualBlockId> ids;
+  problem->problem()->GetResidualBlocks(&ids);
+  int num_leading = 0;
+  const std::vector<double*> columns = LandmarksLast(problem, &num_leading);
+  double cost = 0.0;
+  Eigen::VectorXd residuals;
+  RowMajorSparse jacobian;
+  std::string why;
+  if (!Linearize(problem->problem(), ids, &cost, &residuals, &jacobian, &why,
+                 columns)) {
+    return std::numeric_limits<double>::quiet_NaN();
+  }
+  const std::unique_ptr<GaussNewtonSystem> hessian =
+      SystemForSolves(problem, jacobian, num_leading, columns);
+  if (!hessian->positive_definite()) {
+    return std::numeric_limits<double>::quiet_NaN();
+  }
+  const Eigen::VectorXd gradient = jacobian.transpose() * residuals;
+  return 0.5 * gradient.dot(hessian->Solve(gradient).col(0));
 }
 
 // Adds the covariance of a mean that is itself an estimate (the WNOA
@@ -168,9 +197,12 @@ bool ReportSolution(const SlamOptions& options,
   PriorOf(options).RecordModel(model, result);
   if (!problem->CheckLandmarksDetermined(1e12, error)) return false;
   // Judged against the data as stated: learned sigmas would absorb a misfit.
-  result->quality = AssessQuality(problem->WhitenedResidualsByKind(
-                                      /*stated_sigmas=*/true),
-                                  SolveFactsOf(*settled, *result));
+  SolveFacts facts = SolveFactsOf(*settled, *result);
+  facts.predicted_decrease = options.incremental.every == 0
+                                 ? PredictedDecrease(problem)
+                                 : std::numeric_limits<double>::quiet_NaN();
+  result->quality = AssessQuality(
+      problem->WhitenedResidualsByKind(/*stated_sigmas=*/true), facts);
   for (const auto& [id, position] : landmarks) {
     Landmark l;
     l.id = id;

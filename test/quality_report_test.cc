@@ -110,6 +110,49 @@ TEST(QualityReportTest, UnconvergedSolveAndCalibrationAtItsBoundAreSuspect) {
                           "held by its bound"));
 }
 
+// A solve that reports convergence with the Gauss-Newton model still
+// expecting more than kMaxPredictedDecrease is suspect; one unit less is
+// not, nor is an unknown (NaN) decrease.
+TEST(QualityReportTest, ConvergenceShortOfTheMinimumIsSuspect) {
+  SolveFacts facts;
+  facts.predicted_decrease = 20.6;
+  EXPECT_THAT(AssessQuality({}, facts).reasons,
+              ElementsAre("the Gauss-Newton model still expects the cost to "
+                          "fall by 20.6 (more than 1): the solve stopped "
+                          "short of its minimum"));
+  facts.predicted_decrease = 0.99;
+  EXPECT_EQ(AssessQuality({}, facts).verdict, "ok");
+  facts.predicted_decrease = std::nan("");
+  const QualityReport unknown = AssessQuality({}, facts);
+  EXPECT_EQ(unknown.verdict, "ok");
+  EXPECT_TRUE(std::isnan(unknown.predicted_decrease));
+}
+
+// The paper's protocol solved to its tolerances leaves nothing to gain; a
+// function tolerance of 0.3 makes Levenberg-Marquardt report CONVERGENCE
+// after a step or two, far from the minimum, and the verdict says so.
+TEST(QualityReportTest, SolveStoppedByALooseToleranceIsSuspect) {
+  SimulationOptions sim = PaperOptions(12);
+  sim.num_steps = 120;
+  sim.num_landmarks = 20;
+  Dataset dataset;
+  std::string error;
+  ASSERT_TRUE(Simulate(sim, &dataset, &error)) << error;
+  SlamOptions options = testing::SyntheticRangeBearingOptions();
+  SlamResult converged;
+  ASSERT_TRUE(RunSlam(dataset, options, &converged, &error)) << error;
+  EXPECT_LT(converged.quality.predicted_decrease, 1e-3);
+  EXPECT_EQ(converged.quality.verdict, "ok") << QualityLine(converged.quality);
+  options.solver.function_tolerance = 0.3;
+  SlamResult stopped;
+  ASSERT_TRUE(RunSlam(dataset, options, &stopped, &error)) << error;
+  EXPECT_TRUE(stopped.converged);
+  EXPECT_GT(stopped.quality.predicted_decrease, kMaxPredictedDecrease);
+  EXPECT_THAT(stopped.quality.reasons,
+              Contains(HasSubstr("the Gauss-Newton model still expects the "
+                                 "cost to fall by")));
+}
+
 // Odometry that reads three times the distance travelled: the calibration
 // stops at its bound of 2, and the verdict names it.
 TEST(QualityReportTest, OdometryCalibrationAtItsBoundIsSuspect) {
