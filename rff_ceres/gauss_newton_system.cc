@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "Eigen/LU"
+#include "rff_ceres/banded_minimizer.h"
 #include "rff_ceres/banded_problem.h"
 
 namespace rff {
@@ -175,6 +176,22 @@ std::unique_ptr<GaussNewtonSystem> SystemForSolves(
       banded ? Factorization::kEnvelopeOrSparse : Factorization::kSchurOrSparse,
       analysis,
       banded ? TimeOrderPositions(problem, columns) : std::vector<int>());
+}
+
+bool FactorizeBanded(SlamProblem* problem, BandedSystem* system) {
+  const BandedColumns columns = problem->BandColumns();
+  std::string why;
+  if (!BandedSolvable(*problem->problem(), columns, &why)) return false;
+  system->banded =
+      std::make_unique<BandedProblem>(*problem->problem(), columns);
+  BandedProblem& banded = *system->banded;
+  if (!EnvelopeAffordable(banded.Size())) return false;
+  system->x = banded.Gather();
+  system->factor = std::make_unique<EnvelopeMatrix>(banded.envelope_first());
+  double cost;
+  return banded.Linearize(system->x, &cost, &system->gradient,
+                          system->factor.get()) &&
+         system->factor->Factorize();
 }
 
 bool EnvelopeAffordable(const BandedSize& size) {

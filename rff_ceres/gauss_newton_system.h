@@ -132,6 +132,18 @@ std::unique_ptr<GaussNewtonSystem> SystemForSolves(
     SlamProblem* problem, const RowMajorSparse& jacobian, int num_leading,
     const std::vector<double*>& columns, SparseAnalysis* analysis = nullptr);
 
+// H of a banded-state `problem` at its current values, accumulated from its
+// residual blocks in the time-ordered envelope BANDED_CHOLESKY factorises,
+// and factorised: `banded` the problem's layout, `x` its values, `gradient`
+// J^T r. False where the envelope does not serve (bounds, manifolds, too
+// costly, or H not positive definite to rounding).
+struct BandedSystem {
+  std::unique_ptr<BandedProblem> banded;
+  Eigen::VectorXd x, gradient;
+  std::unique_ptr<EnvelopeMatrix> factor;
+};
+bool FactorizeBanded(SlamProblem* problem, BandedSystem* system);
+
 }  // namespace rff
 
 #endif  // RFF_CERES_GAUSS_NEWTON_SYSTEM_H_

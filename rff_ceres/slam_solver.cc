@@ -67,6 +67,11 @@ SolveFacts SolveFactsOf(const SlamOptions& options, const SlamResult& result) {
 // expects to gain (SolveFacts::predicted_decrease); NaN where H is not
 // positive definite.
 double PredictedDecrease(SlamProblem* problem) {
+  BandedSystem banded;
+  if (!problem->model().HasDenseReducedSystem() &&
+      FactorizeBanded(problem, &banded)) {
+    return 0.5 * banded.gradient.dot(banded.factor->Solve(banded.gradient));
+  }
   std::vector<ceres::ResidualBlockId> ids;
   problem->problem()->GetResidualBlocks(&ids);
   int num_leading = 0;

@@ -6,7 +6,6 @@
 
 #include "ceres/crs_matrix.h"
 #include "glog/logging.h"
-#include "rff_ceres/banded_minimizer.h"
 #include "rff_ceres/banded_problem.h"
 #include "rff_ceres/gauss_newton_system.h"
 
@@ -93,23 +92,15 @@ bool BandedTraces(SlamProblem* problem, const std::vector<double*>& ll_columns,
                   const VarianceComponentOptions& options, std::mt19937* engine,
                   Eigen::VectorXd* residuals,
                   std::array<double, kNumVarianceGroups>* traces) {
-  const BandedColumns columns = problem->BandColumns();
-  std::string why;
-  if (!BandedSolvable(*problem->problem(), columns, &why)) return false;
-  BandedProblem banded(*problem->problem(), columns);
+  BandedSystem system;
+  if (!FactorizeBanded(problem, &system)) return false;
+  BandedProblem& banded = *system.banded;
+  const EnvelopeMatrix& hessian = *system.factor;
+  const Eigen::VectorXd& x = system.x;
   const std::vector<int> position = TimeOrderPositions(problem, ll_columns);
   const int n = banded.num_columns();
   if (static_cast<int>(position.size()) != n ||
-      banded.num_rows() != static_cast<int>(groups.size()) ||
-      !EnvelopeAffordable(banded.Size())) {
-    return false;
-  }
-  const Eigen::VectorXd x = banded.Gather();
-  EnvelopeMatrix hessian(banded.envelope_first());
-  double cost;
-  Eigen::VectorXd gradient;
-  if (!banded.Linearize(x, &cost, &gradient, &hessian) ||
-      !hessian.Factorize()) {
+      banded.num_rows() != static_cast<int>(groups.size())) {
     return false;
   }
   const int per_pass = ProbesPerPass(n, options.probes);
