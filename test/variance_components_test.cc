@@ -13,6 +13,8 @@
 #include "ceres/solver.h"
 #include "gtest/gtest.h"
 #include "rff_ceres/banded_problem.h"
+#include "rff_ceres/consistency.h"
+#include "rff_ceres/io/pose_covariance_io.h"
 #include "rff_ceres/io/text_parser.h"
 #include "rff_ceres/landmark_init.h"
 #include "rff_ceres/mean/prior_mean.h"
@@ -350,6 +352,46 @@ void ExpectRedundanciesMatchTheExactTraces(const SlamOptions& given) {
   }
   // The start's priors are not rescaled.
   EXPECT_EQ(components[static_cast<int>(VarianceGroup::kFixed)].factor, 1.0);
+}
+
+// On twenty draws from the WNOA prior itself (its own model), the default
+// solve (Q_c and the noise scales learned) gives pose covariances whose
+// pooled mean position NEES is within 10% of 2. The map is known (priors
+// 0.01 m), so each run's errors are local and the pooled mean pins the
+// consistency, not one frame's draw.
+TEST(VarianceComponentsTest, WnoaCovarianceIsConsistentOnItsOwnDraws) {
+  double nees_sum = 0.0;
+  int runs = 0;
+  for (std::uint64_t seed = 1; seed <= 20; ++seed) {
+    const Dataset dataset = WnoaDraw(seed, 150, 0.01, 1e-4);
+    SlamOptions options;
+    options.prior = "wnoa";
+    options.output.covariance = true;
+    SlamResult result;
+    std::string error;
+    ASSERT_TRUE(RunSlam(dataset, options, &result, &error)) << error;
+    std::vector<PoseCovariance> covariances;
+    for (std::size_t k = 0; k < result.trajectory.size(); ++k) {
+      covariances.push_back(
+          {result.trajectory[k].t, result.pose_covariances[k]});
+    }
+    Evaluation evaluation;
+    ASSERT_TRUE(Evaluate(dataset.ground_truth, dataset.ground_truth_landmarks,
+                         result.trajectory, &result.landmarks,
+                         EvaluationOptions(), &evaluation, &error))
+        << error;
+    ASSERT_TRUE(EvaluateConsistency(dataset.ground_truth, result.trajectory,
+                                    covariances, &evaluation, &error))
+        << error;
+    std::printf("seed %llu: position NEES %.3f\n",
+                static_cast<unsigned long long>(seed),
+                evaluation.consistency.mean_position_nees);
+    nees_sum += evaluation.consistency.mean_position_nees;
+    ++runs;
+  }
+  const double pooled = nees_sum / runs;
+  std::printf("pooled mean position NEES %.3f over %d draws\n", pooled, runs);
+  EXPECT_NEAR(pooled, 2.0, 0.2);
 }
 
 // WNOA states: the probes go through the time-ordered envelope, J z term by
