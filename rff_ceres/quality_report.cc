@@ -58,8 +58,7 @@ QualityReport AssessQuality(
         "the Gauss-Newton model still expects the cost to fall by " +
         Short(facts.predicted_decrease) + " (more than " +
         Short(kMaxPredictedDecrease) +
-        "): the solve stopped short of its "
-        "minimum");
+        "): the solve stopped short of its minimum");
   }
   for (const auto& [kind, values] : residuals) {
     if (values.empty()) continue;

@@ -29,8 +29,9 @@ inline constexpr double kMaxShareBeyond3Sigma = 0.05;
 // when that many beyond 3 sigma would be rarer than this under N(0, 1).
 inline constexpr double kOutlierCountProbability = 1e-3;
 // A minimum leaves the Gauss-Newton model nothing to gain: a solve that
-// "converged" with more than this (half a chi-square unit on each of two
-// parameters' worth) still ahead stopped on a flat step short of it.
+// "converged" with more than this still ahead (a chi-square of 2 between
+// the estimate and the model's minimum, 1.4 standard deviations along the
+// step) stopped on a flat step short of it.
 inline constexpr double kMaxPredictedDecrease = 1.0;
 
 // The |r| that n draws of N(0, 1) all stay within with probability
