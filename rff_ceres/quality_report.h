@@ -62,8 +62,8 @@ struct SolveFacts {
   bool converged = true;  // Ceres reported CONVERGENCE.
   std::string termination;
   // The cost the Gauss-Newton model still expects to gain at the solution,
-  // g^T H^-1 g / 2; NaN where it is not known (H not positive definite,
-  // incremental updates).
+  // g^T H^-1 g / 2, or a lower bound of it; NaN where it is not known (an
+  // evaluation fails, H not positive definite, incremental updates).
   double predicted_decrease = 0.0;
   // Range self-calibration: (scale, offset), (1, 0) when not estimated, and
   // whether a bound of slam_problem.h holds it.

@@ -230,7 +230,7 @@ void WriteSummaryJson(const SlamOptions& options, const SlamResult& result,
       << "  \"quality\": " << JsonString(result.quality.verdict) << ",\n"
       << "  \"quality_reasons\": " << JsonStringArray(result.quality.reasons)
       << ",\n"
-      // null where not known (H not positive definite, incremental).
+      // null where not known (SolveFacts::predicted_decrease).
       << "  \"predicted_decrease\": "
       << (std::isfinite(result.quality.predicted_decrease)
               ? FormatNumber(result.quality.predicted_decrease)

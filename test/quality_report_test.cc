@@ -141,19 +141,31 @@ Dataset ShortPaperRun() {
 
 // A function tolerance of 0.3 makes Levenberg-Marquardt report CONVERGENCE
 // after a step or two, far from the minimum, and the verdict says so (the
-// same run solved to its tolerances: SolveOfContradictoryOdometryIsSuspect).
+// same run solved to its tolerances: SolveOfContradictoryOdometryIsSuspect),
+// with feature weights (the conjugate-gradient bound) and with WNOA states
+// (the envelope's exact value; at the default tolerances below 1e-3).
 TEST(QualityReportTest, SolveStoppedByALooseToleranceIsSuspect) {
   const Dataset dataset = ShortPaperRun();
-  SlamOptions options = testing::SyntheticRangeBearingOptions();
-  options.solver.function_tolerance = 0.3;
-  std::string error;
-  SlamResult stopped;
-  ASSERT_TRUE(RunSlam(dataset, options, &stopped, &error)) << error;
-  EXPECT_TRUE(stopped.converged);
-  EXPECT_GT(stopped.quality.predicted_decrease, kMaxPredictedDecrease);
-  EXPECT_THAT(stopped.quality.reasons,
-              Contains(HasSubstr("the Gauss-Newton model still expects the "
-                                 "cost to fall by")));
+  for (const std::string prior : {"rff", "wnoa"}) {
+    SlamOptions options = testing::SyntheticRangeBearingOptions();
+    options.prior = prior;
+    std::string error;
+    if (prior == "wnoa") {
+      SlamResult converged;
+      ASSERT_TRUE(RunSlam(dataset, options, &converged, &error)) << error;
+      EXPECT_LT(converged.quality.predicted_decrease, 1e-3);
+    }
+    options.solver.function_tolerance = 0.3;
+    SlamResult stopped;
+    ASSERT_TRUE(RunSlam(dataset, options, &stopped, &error)) << error;
+    EXPECT_TRUE(stopped.converged) << prior;
+    EXPECT_GT(stopped.quality.predicted_decrease, kMaxPredictedDecrease)
+        << prior;
+    EXPECT_THAT(stopped.quality.reasons,
+                Contains(HasSubstr("the Gauss-Newton model still expects the "
+                                   "cost to fall by")))
+        << prior;
+  }
 }
 
 // Odometry that reads three times the distance travelled: the calibration
