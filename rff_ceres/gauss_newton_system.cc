@@ -165,19 +165,6 @@ std::vector<int> TimeOrderPositions(SlamProblem* problem,
   return position;
 }
 
-std::unique_ptr<GaussNewtonSystem> SystemForSolves(
-    SlamProblem* problem, const RowMajorSparse& jacobian, int num_leading,
-    const std::vector<double*>& columns, SparseAnalysis* analysis) {
-  // Banded states skip the dense Schur complement their solver does
-  // without too (AutoLinearSolverType).
-  const bool banded = !problem->model().HasDenseReducedSystem();
-  return std::make_unique<GaussNewtonSystem>(
-      jacobian, num_leading,
-      banded ? Factorization::kEnvelopeOrSparse : Factorization::kSchurOrSparse,
-      analysis,
-      banded ? TimeOrderPositions(problem, columns) : std::vector<int>());
-}
-
 bool FactorizeBanded(SlamProblem* problem, BandedSystem* system) {
   const BandedColumns columns = problem->BandColumns();
   std::string why;

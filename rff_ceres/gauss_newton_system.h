@@ -123,15 +123,6 @@ class GaussNewtonSystem {
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>* sparse_ = &own_sparse_;
 };
 
-// H of `jacobian`, the Jacobian of `problem` over `columns` (LandmarksLast,
-// `num_leading` before the landmarks), factorised for solves as the
-// model's structure asks: banded states in the time-ordered envelope,
-// others in the Schur form, either as the sparse LDLT where it does not
-// serve.
-std::unique_ptr<GaussNewtonSystem> SystemForSolves(
-    SlamProblem* problem, const RowMajorSparse& jacobian, int num_leading,
-    const std::vector<double*>& columns, SparseAnalysis* analysis = nullptr);
-
 // H of a banded-state `problem` at its current values, accumulated from its
 // residual blocks in the time-ordered envelope BANDED_CHOLESKY factorises,
 // and factorised: `banded` the problem's layout, `x` its values, `gradient`

@@ -140,9 +140,14 @@ bool SparseTraces(SlamProblem* problem, const std::vector<double*>& columns,
     return false;
   }
   CHECK_EQ(static_cast<Eigen::Index>(groups.size()), residuals->size());
-  const std::unique_ptr<GaussNewtonSystem> system =
-      SystemForSolves(problem, jacobian, num_leading, columns, analysis);
-  const GaussNewtonSystem& hessian = *system;
+  // Only traces and solves are needed: banded states skip the dense Schur
+  // complement their solver does without too (AutoLinearSolverType).
+  const bool banded = !problem->model().HasDenseReducedSystem();
+  const GaussNewtonSystem hessian(
+      jacobian, num_leading,
+      banded ? Factorization::kEnvelopeOrSparse : Factorization::kSchurOrSparse,
+      analysis,
+      banded ? TimeOrderPositions(problem, columns) : std::vector<int>());
   if (!hessian.positive_definite()) {
     *error = "the Gauss-Newton Hessian is not positive definite";
     return false;
