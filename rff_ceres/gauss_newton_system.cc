@@ -1,6 +1,7 @@
 #include "rff_ceres/gauss_newton_system.h"
 
 #include <algorithm>
+#include <limits>
 #include <unordered_map>
 #include <utility>
 #include <vector>
@@ -8,6 +9,7 @@
 #include "Eigen/LU"
 #include "rff_ceres/banded_minimizer.h"
 #include "rff_ceres/banded_problem.h"
+#include "rff_ceres/variance_components.h"
 
 namespace rff {
 namespace {
@@ -179,6 +181,62 @@ bool FactorizeBanded(SlamProblem* problem, BandedSystem* system) {
   return banded.Linearize(system->x, &cost, &system->gradient,
                           system->factor.get()) &&
          system->factor->Factorize();
+}
+
+namespace {
+
+// Conjugate-gradient steps of GaussNewtonDecrease where H has no envelope.
+constexpr int kMaxDecreaseIterations = 100;
+
+}  // namespace
+
+double GaussNewtonDecrease(SlamProblem* problem) {
+  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+  BandedSystem banded;
+  if (!problem->model().HasDenseReducedSystem() &&
+      FactorizeBanded(problem, &banded)) {
+    return 0.5 * banded.gradient.dot(banded.factor->Solve(banded.gradient));
+  }
+  std::vector<ceres::ResidualBlockId> ids;
+  problem->problem()->GetResidualBlocks(&ids);
+  double cost = 0.0;
+  Eigen::VectorXd residuals;
+  RowMajorSparse jacobian;
+  std::string why;
+  if (!Linearize(problem->problem(), ids, &cost, &residuals, &jacobian, &why)) {
+    return kNaN;
+  }
+  const Eigen::VectorXd gradient = jacobian.transpose() * residuals;
+  // Jacobi preconditioner; an empty column (a block no residual moves) has
+  // no gradient and keeps x at 0 whatever its entry.
+  Eigen::VectorXd diagonal = Eigen::VectorXd::Zero(jacobian.cols());
+  for (Eigen::Index r = 0; r < jacobian.outerSize(); ++r) {
+    for (RowMajorSparse::InnerIterator it(jacobian, r); it; ++it) {
+      diagonal[it.col()] += it.value() * it.value();
+    }
+  }
+  for (double& d : diagonal) {
+    if (d == 0.0) d = 1.0;
+  }
+  // Preconditioned CG on H x = g from x = 0: g^T x after k steps is the
+  // lower bound.
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(gradient.size());
+  Eigen::VectorXd r = gradient, z = r.cwiseQuotient(diagonal), p = z;
+  double rz = r.dot(z);
+  const double stop = 1e-12 * rz;  // The residual down by 1e6.
+  for (int k = 0; k < kMaxDecreaseIterations && rz > stop; ++k) {
+    const Eigen::VectorXd hp = jacobian.transpose() * (jacobian * p);
+    const double curvature = p.dot(hp);
+    if (!(curvature > 0.0)) return kNaN;
+    const double alpha = rz / curvature;
+    x += alpha * p;
+    r -= alpha * hp;
+    z = r.cwiseQuotient(diagonal);
+    const double next = r.dot(z);
+    p = z + (next / rz) * p;
+    rz = next;
+  }
+  return 0.5 * gradient.dot(x);
 }
 
 bool EnvelopeAffordable(const BandedSize& size) {

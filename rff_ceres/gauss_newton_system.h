@@ -135,6 +135,17 @@ struct BandedSystem {
 };
 bool FactorizeBanded(SlamProblem* problem, BandedSystem* system);
 
+// g^T H^-1 g / 2 at the problem's values, g = J^T r and H = J^T J of its
+// whitened, loss-corrected residuals: what the Gauss-Newton model still
+// expects to gain (a minimum leaves nothing). Banded states solve with H's
+// envelope factor (FactorizeBanded); other models take at most 100 steps
+// of conjugate gradients on J^T J with H's diagonal as preconditioner,
+// whose estimate rises towards the value from below (Gauss quadrature:
+// Golub and Meurant 2010, 3.2), so no dense reduced system is factorised
+// for a check and a decrease it finds is there. NaN where it cannot tell
+// (an evaluation fails, H not positive definite).
+double GaussNewtonDecrease(SlamProblem* problem);
+
 }  // namespace rff
 
 #endif  // RFF_CERES_GAUSS_NEWTON_SYSTEM_H_

@@ -19,7 +19,6 @@
 #include "rff_ceres/priors/trajectory_prior.h"
 #include "rff_ceres/scale_learning.h"
 #include "rff_ceres/solve_start.h"
-#include "rff_ceres/variance_components.h"
 
 namespace rff {
 
@@ -60,61 +59,6 @@ SolveFacts SolveFactsOf(const SlamOptions& options, const SlamResult& result) {
       result.odometry_calibration.minCoeff() < kMinOdometryScale + kAtBound ||
       result.odometry_calibration.maxCoeff() > kMaxOdometryScale - kAtBound;
   return facts;
-}
-
-// g^T H^-1 g / 2 at the problem's values, g = J^T r and H = J^T J of its
-// whitened, loss-corrected residuals: what the Gauss-Newton model still
-// expects to gain (SolveFacts::predicted_decrease). Banded states solve
-// with H's envelope factor; other models by conjugate gradients on J^T J
-// with H's diagonal as preconditioner, at most kMaxGradientIterations,
-// whose estimate rises towards g^T H^-1 g from below (Gauss quadrature:
-// Golub & Meurant 2010, 3.2), so a decrease it finds above the verdict's
-// bound is there: no factorisation of a dense reduced system for a check.
-// NaN where it cannot tell (an evaluation fails, H not positive definite).
-constexpr int kMaxGradientIterations = 100;
-double PredictedDecrease(SlamProblem* problem) {
-  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-  BandedSystem banded;
-  if (!problem->model().HasDenseReducedSystem() &&
-      FactorizeBanded(problem, &banded)) {
-    return 0.5 * banded.gradient.dot(banded.factor->Solve(banded.gradient));
-  }
-  std::vector<ceres::ResidualBlockId> ids;
-  problem->problem()->GetResidualBlocks(&ids);
-  double cost = 0.0;
-  Eigen::VectorXd residuals;
-  RowMajorSparse jacobian;
-  std::string why;
-  if (!Linearize(problem->problem(), ids, &cost, &residuals, &jacobian, &why)) {
-    return kNaN;
-  }
-  const Eigen::VectorXd gradient = jacobian.transpose() * residuals;
-  Eigen::VectorXd diagonal = Eigen::VectorXd::Zero(jacobian.cols());
-  for (Eigen::Index r = 0; r < jacobian.outerSize(); ++r) {
-    for (RowMajorSparse::InnerIterator it(jacobian, r); it; ++it) {
-      diagonal[it.col()] += it.value() * it.value();
-    }
-  }
-  if (!(diagonal.minCoeff() > 0.0)) return kNaN;
-  // Preconditioned CG on H x = g from x = 0; g^T x after k steps is the
-  // lower bound.
-  Eigen::VectorXd x = Eigen::VectorXd::Zero(gradient.size());
-  Eigen::VectorXd r = gradient, z = r.cwiseQuotient(diagonal), p = z;
-  double rz = r.dot(z);
-  const double stop = 1e-12 * rz;  // The residual down by 1e6.
-  for (int k = 0; k < kMaxGradientIterations && rz > stop; ++k) {
-    const Eigen::VectorXd hp = jacobian.transpose() * (jacobian * p);
-    const double curvature = p.dot(hp);
-    if (!(curvature > 0.0)) return kNaN;
-    const double alpha = rz / curvature;
-    x += alpha * p;
-    r -= alpha * hp;
-    z = r.cwiseQuotient(diagonal);
-    const double next = r.dot(z);
-    p = z + (next / rz) * p;
-    rz = next;
-  }
-  return 0.5 * gradient.dot(x);
 }
 
 // Adds the covariance of a mean that is itself an estimate (the WNOA
@@ -228,7 +172,7 @@ bool ReportSolution(const SlamOptions& options,
   // Judged against the data as stated: learned sigmas would absorb a misfit.
   SolveFacts facts = SolveFactsOf(*settled, *result);
   facts.predicted_decrease = options.incremental.every == 0
-                                 ? PredictedDecrease(problem)
+                                 ? GaussNewtonDecrease(problem)
                                  : std::numeric_limits<double>::quiet_NaN();
   result->quality = AssessQuality(
       problem->WhitenedResidualsByKind(/*stated_sigmas=*/true), facts);

@@ -1,9 +1,16 @@
 #include "rff_ceres/gauss_newton_system.h"
 
+#include <memory>
 #include <random>
+#include <string>
 #include <vector>
 
+#include "Eigen/Dense"
 #include "gtest/gtest.h"
+#include "rff_ceres/mean/prior_mean.h"
+#include "rff_ceres/priors/trajectory_prior.h"
+#include "rff_ceres/simulate.h"
+#include "rff_ceres/variance_components.h"
 
 namespace rff {
 namespace {
@@ -226,6 +233,56 @@ TEST(GaussNewtonSystemTest, SchurOnlyLeavesASystemWithoutTheFormUnfactorised) {
   const GaussNewtonSystem fallback(jacobian, t, Factorization::kSchurOrSparse);
   EXPECT_FALSE(fallback.structured());
   EXPECT_TRUE(fallback.positive_definite());
+}
+
+// g^T H^-1 g / 2 away from the minimum (landmarks 0.3 m off, nothing
+// solved): WNOA states through the envelope give the dense value to
+// rounding; feature weights by conjugate gradients a lower bound, here
+// within 0.1% of it (measured 219.346 against 219.441: 100 steps in finite
+// precision on an ill-conditioned H).
+TEST(GaussNewtonDecreaseTest, IsTheDenseValueOrABoundBelowIt) {
+  SimulationOptions simulation = PaperOptions(4);
+  simulation.num_steps = 60;
+  simulation.num_landmarks = 12;
+  Dataset dataset;
+  std::string error;
+  ASSERT_TRUE(Simulate(simulation, &dataset, &error)) << error;
+  for (const std::string prior : {"wnoa", "rff"}) {
+    SlamOptions options;
+    options.prior = prior;
+    options.features.num_position_features = 12;
+    options.features.num_heading_features = 12;
+    const std::shared_ptr<const MeanFunction> mean =
+        BuildPriorMean("constant", dataset, options.localization,
+                       kPaperSplineSmoothing, &error);
+    ASSERT_NE(mean, nullptr) << error;
+    const std::unique_ptr<TrajectoryModel> model =
+        CreateTrajectoryModel(dataset, options, mean, &error);
+    ASSERT_NE(model, nullptr) << error;
+    std::map<LandmarkId, Eigen::Vector2d> landmarks;
+    for (const Landmark& l : dataset.ground_truth_landmarks) {
+      landmarks[l.id] = Eigen::Vector2d(l.x + 0.3, l.y - 0.3);
+    }
+    SlamProblem problem(model.get(), options.problem);
+    ASSERT_TRUE(problem.Build(dataset, landmarks, &error)) << error;
+    std::vector<ceres::ResidualBlockId> ids;
+    problem.problem()->GetResidualBlocks(&ids);
+    double cost = 0.0;
+    Eigen::VectorXd residuals;
+    RowMajorSparse sparse;
+    ASSERT_TRUE(
+        Linearize(problem.problem(), ids, &cost, &residuals, &sparse, &error));
+    const Eigen::MatrixXd j = sparse;
+    const Eigen::VectorXd g = j.transpose() * residuals;
+    const double dense = 0.5 * g.dot((j.transpose() * j).ldlt().solve(g));
+    const double decrease = GaussNewtonDecrease(&problem);
+    std::printf("%s: %lld weights, decrease %.9g, dense %.9g\n", prior.c_str(),
+                static_cast<long long>(j.cols()), decrease, dense);
+    EXPECT_GT(dense, 1.0) << prior;
+    EXPECT_LE(decrease, dense * (1.0 + 1e-9)) << prior;
+    EXPECT_NEAR(decrease, dense, (prior == "wnoa" ? 1e-9 : 1e-3) * dense)
+        << prior;
+  }
 }
 
 }  // namespace
