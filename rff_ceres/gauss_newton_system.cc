@@ -168,6 +168,7 @@ std::vector<int> TimeOrderPositions(SlamProblem* problem,
 }
 
 bool FactorizeBanded(SlamProblem* problem, BandedSystem* system) {
+  if (problem->model().HasDenseReducedSystem()) return false;
   const BandedColumns columns = problem->BandColumns();
   std::string why;
   if (!BandedSolvable(*problem->problem(), columns, &why)) return false;
@@ -193,8 +194,7 @@ constexpr int kMaxDecreaseIterations = 100;
 double GaussNewtonDecrease(SlamProblem* problem) {
   constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
   BandedSystem banded;
-  if (!problem->model().HasDenseReducedSystem() &&
-      FactorizeBanded(problem, &banded)) {
+  if (FactorizeBanded(problem, &banded)) {
     return 0.5 * banded.gradient.dot(banded.factor->Solve(banded.gradient));
   }
   std::vector<ceres::ResidualBlockId> ids;

@@ -126,8 +126,9 @@ class GaussNewtonSystem {
 // H of a banded-state `problem` at its current values, accumulated from its
 // residual blocks in the time-ordered envelope BANDED_CHOLESKY factorises,
 // and factorised: `banded` the problem's layout, `x` its values, `gradient`
-// J^T r. False where the envelope does not serve (bounds, manifolds, too
-// costly, or H not positive definite to rounding).
+// J^T r. False for a model with a dense reduced system (features) and
+// where the envelope does not serve (bounds, manifolds, too costly, or H
+// not positive definite to rounding).
 struct BandedSystem {
   std::unique_ptr<BandedProblem> banded;
   Eigen::VectorXd x, gradient;

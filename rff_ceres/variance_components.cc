@@ -83,10 +83,10 @@ Eigen::MatrixXd DrawProbes(Eigen::Index n, int count, std::mt19937* engine) {
 // factorises: H from the residual blocks themselves, J z and J H^-1 z term
 // by term, nothing stored per row of J. Probes are drawn over the columns
 // `ll_columns` (LandmarksLast) as the sparse path draws them, so both see
-// the same probes. False before drawing any where the envelope does not
-// serve (bounds, manifolds, constant blocks, too costly, or H not positive
-// definite to rounding): the sparse path decides then. `traces` is written
-// only on success.
+// the same probes. False, before drawing any, for models FactorizeBanded
+// refuses and problems with constant blocks: the sparse path decides then;
+// false after drawing only where an evaluation fails, which the sparse
+// path's evaluation then reports. `traces` is written only on success.
 bool BandedTraces(SlamProblem* problem, const std::vector<double*>& ll_columns,
                   const std::vector<VarianceGroup>& groups,
                   const VarianceComponentOptions& options, std::mt19937* engine,
@@ -183,8 +183,7 @@ bool EstimateVarianceComponents(SlamProblem* problem,
   std::array<double, kNumVarianceGroups> traces{};
   std::mt19937 engine(options.seed);
   Eigen::VectorXd residuals;
-  const bool banded = !problem->model().HasDenseReducedSystem() &&
-                      BandedTraces(problem, columns, groups, options, &engine,
+  const bool banded = BandedTraces(problem, columns, groups, options, &engine,
                                    &residuals, &traces);
   if (!banded &&
       !SparseTraces(problem, columns, num_leading, ids, groups, options,
