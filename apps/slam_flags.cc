@@ -189,6 +189,10 @@ DEFINE_double(gradient_tolerance, 1e-10,
               "Ceres gradient tolerance, 0 or more.");
 DEFINE_double(parameter_tolerance, 1e-8,
               "Ceres parameter tolerance, 0 or more.");
+DEFINE_double(decrement_tolerance, 0.01,
+              "BANDED_CHOLESKY: also converged once a nearly undamped step "
+              "is predicted by the Gauss-Newton model to lower the cost by "
+              "less than this, 0 or more; 0: Ceres's stopping rules only.");
 
 namespace rff {
 namespace {
@@ -275,6 +279,7 @@ SlamOptions SlamOptionsFromFlags() {
   s.function_tolerance = FLAGS_function_tolerance;
   s.gradient_tolerance = FLAGS_gradient_tolerance;
   s.parameter_tolerance = FLAGS_parameter_tolerance;
+  s.decrement_tolerance = FLAGS_decrement_tolerance;
   s.log_progress = true;
   s.max_memory_gb = FLAGS_max_memory_gb;
   return options;

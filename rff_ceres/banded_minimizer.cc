@@ -20,6 +20,10 @@ double Now() {
       .count();
 }
 
+// Trust radii from which the LM damping, the scaled diagonal / radius, is
+// too small to shorten a step noticeably.
+constexpr double kUndampedRadius = 1e8;
+
 std::string MessageWith(const char* format, double a, double b) {
   char text[160];
   std::snprintf(text, sizeof(text), format, a, b);
@@ -64,7 +68,8 @@ bool BandedSolvable(const ceres::Problem& problem, const BandedColumns& columns,
 
 void MinimizeBanded(const ceres::Solver::Options& options,
                     BandedProblem* banded, ceres::Problem* problem,
-                    ceres::Solver::Summary* summary) {
+                    ceres::Solver::Summary* summary,
+                    double decrement_tolerance) {
   CHECK(options.jacobi_scaling && !options.use_nonmonotonic_steps &&
         !options.use_inner_iterations)
       << "MinimizeBanded implements Ceres's default trust-region loop only";
@@ -130,6 +135,9 @@ void MinimizeBanded(const ceres::Solver::Options& options,
     decrease_factor *= 2.0;
   };
   int invalid_steps = 0;
+  // The Gauss-Newton decrease the last accepted step was predicted to make.
+  double accepted_model_decrease = std::numeric_limits<double>::infinity();
+  double accepted_radius = 0.0;  // The trust radius it was solved with.
   ceres::IterationSummary it;
   it.step_is_valid = it.step_is_successful = true;
   it.eta = options.eta;
@@ -185,6 +193,17 @@ void MinimizeBanded(const ceres::Solver::Options& options,
           MessageWith("Gradient tolerance reached. Gradient max norm: "
                       "%e <= %e",
                       it.gradient_max_norm, options.gradient_tolerance));
+    }
+    // A nearly undamped step the model valued at less than the tolerance,
+    // taken: what is left is as small (Boyd and Vandenberghe 2004, 9.5.1,
+    // Newton's decrement). A damped step understates it.
+    if (it.step_is_successful && accepted_radius >= kUndampedRadius &&
+        accepted_model_decrease <= decrement_tolerance) {
+      return finish(
+          ceres::CONVERGENCE,
+          MessageWith("Gauss-Newton decrement tolerance reached. Predicted "
+                      "decrease of the last step: %e <= %e",
+                      accepted_model_decrease, decrement_tolerance));
     }
     if (radius <= options.min_trust_region_radius) {
       return finish(
@@ -280,6 +299,8 @@ void MinimizeBanded(const ceres::Solver::Options& options,
                       "Residual and Jacobian evaluation failed.");
       }
       next.step_is_successful = true;
+      accepted_model_decrease = model_cost_change;
+      accepted_radius = radius;
       next.cost = cost + fixed_cost;
       next.gradient_max_norm = gradient.lpNorm<Eigen::Infinity>();
       next.gradient_norm = gradient.norm();

@@ -31,10 +31,14 @@ bool BandedSolvable(const ceres::Problem& problem, const BandedColumns& columns,
 // trust region radii, LM diagonal bounds, iteration and time limits,
 // callbacks and update_state_every_iteration; it runs on one thread with
 // Ceres's defaults of Jacobi scaling, monotonic steps and no inner
-// iterations, which rff_slam never changes (checked).
+// iterations, which rff_slam never changes (checked). With
+// `decrement_tolerance` > 0 it also stops, converged, after a nearly
+// undamped step that the Gauss-Newton model valued below it (the cost's
+// units): Ceres has no such rule, so 0 keeps Ceres's steps exactly.
 void MinimizeBanded(const ceres::Solver::Options& options,
                     BandedProblem* banded, ceres::Problem* problem,
-                    ceres::Solver::Summary* summary);
+                    ceres::Solver::Summary* summary,
+                    double decrement_tolerance = 0.0);
 
 }  // namespace rff
 

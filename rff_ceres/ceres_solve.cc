@@ -106,7 +106,8 @@ bool ToCeresOptions(const SolverOptions& options,
   for (const auto& [flag, tolerance] :
        {std::pair("function_tolerance", options.function_tolerance),
         std::pair("gradient_tolerance", options.gradient_tolerance),
-        std::pair("parameter_tolerance", options.parameter_tolerance)}) {
+        std::pair("parameter_tolerance", options.parameter_tolerance),
+        std::pair("decrement_tolerance", options.decrement_tolerance)}) {
     if (!CheckNonNegativeOption(tolerance, flag, error)) return false;
   }
   ceres_options->num_threads = options.num_threads;
@@ -217,7 +218,7 @@ bool RunSolve(const SolverOptions& solver, ceres::Solver::Options ceres_options,
             "system in time order";
       }
       MinimizeBanded(ceres_options, banded.get(), problem->problem(),
-                     &result->summary);
+                     &result->summary, solver.decrement_tolerance);
       return CheckSolve(result->summary, problem, error);
     }
     if (asked) {

@@ -119,6 +119,10 @@ const AppCase kAppCases[] = {
     {"SlamNegativeTolerance", SLAM "--function_tolerance=-1" SLAM_OUT,
      "rff_slam: error: --function_tolerance=-1: allowed 0 or more\n",
      "{dir}/out.tum"},
+    {"SlamNegativeDecrementTolerance",
+     SLAM "--decrement_tolerance=-0.5" SLAM_OUT,
+     "rff_slam: error: --decrement_tolerance=-0.5: allowed 0 or more\n",
+     "{dir}/out.tum"},
     {"SlamUnknownLinearSolver", SLAM "--linear_solver=MAGIC" SLAM_OUT,
      "rff_slam: error: --linear_solver=MAGIC: unknown linear solver; allowed "
      "auto, BANDED_CHOLESKY, DENSE_SCHUR, SPARSE_SCHUR, ITERATIVE_SCHUR, "

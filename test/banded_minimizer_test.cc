@@ -125,9 +125,10 @@ ceres::Solver::Options SparseCholesky() {
 // `problem` laid out as `columns` and minimised by the banded loop.
 void Minimize(const ceres::Solver::Options& options,
               const BandedColumns& columns, ceres::Problem* problem,
-              ceres::Solver::Summary* summary) {
+              ceres::Solver::Summary* summary,
+              double decrement_tolerance = 0.0) {
   BandedProblem banded(*problem, columns);
-  MinimizeBanded(options, &banded, problem, summary);
+  MinimizeBanded(options, &banded, problem, summary, decrement_tolerance);
 }
 
 // The envelope's size with `problem` laid out as `columns`.
@@ -260,6 +261,43 @@ TEST(BandedMinimizerTest, MatchesCeresWithFixedCostAndAnUnusedBlock) {
       (banded_side.Values() - ceres_side.Values()).lpNorm<Eigen::Infinity>(),
       1e-9);
   EXPECT_EQ(banded_unused, Eigen::Vector2d(1e6, 1e6));
+}
+
+// Outliers at the knee of a Cauchy loss: a long tail of small steps (21,
+// each a third of the one before: the Gauss-Newton model's surplus
+// curvature there), which the decrement tolerance cuts once the steps are
+// undamped, within it of the minimum; while the damping still counts (the
+// radius capped) it waits.
+TEST(BandedMinimizerTest, StopsAtTheDecrementToleranceOnceUndamped) {
+  ceres::CauchyLoss loss(1.0);
+  ceres::Solver::Options options = SparseCholesky();
+  options.function_tolerance = 1e-12;
+  options.parameter_tolerance = 1e-12;
+  options.initial_trust_region_radius = 1e8;
+  auto solve = [&](double tolerance, ceres::Solver::Summary* summary) {
+    ChainProblem chain(80, &loss, 0.08);
+    Minimize(options, chain.Columns(), chain.problem.get(), summary, tolerance);
+  };
+  ceres::Solver::Summary full, cut, damped, damped_full;
+  solve(0.0, &full);
+  solve(1e-3, &cut);
+  ASSERT_EQ(full.termination_type, ceres::CONVERGENCE);
+  EXPECT_EQ(full.message.rfind("Function tolerance reached", 0), 0u)
+      << full.message;
+  EXPECT_EQ(cut.termination_type, ceres::CONVERGENCE);
+  EXPECT_EQ(cut.message.rfind("Gauss-Newton decrement tolerance reached", 0),
+            0u)
+      << cut.message;
+  EXPECT_LT(cut.iterations.size() + 3, full.iterations.size());
+  EXPECT_GE(cut.final_cost, full.final_cost);
+  EXPECT_LE(cut.final_cost, full.final_cost + 1e-3);
+
+  options.initial_trust_region_radius = 1e4;
+  options.max_trust_region_radius = 1e6;
+  solve(0.0, &damped_full);
+  solve(1e-3, &damped);
+  EXPECT_EQ(damped.iterations.size(), damped_full.iterations.size());
+  EXPECT_EQ(damped.message, damped_full.message);
 }
 
 TEST(BandedMinimizerTest, NothingToSolveIsConvergedAtTheFixedCost) {

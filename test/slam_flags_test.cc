@@ -86,6 +86,7 @@ TEST(SlamFlagsTest, DefaultFlagsGiveTheLibraryDefaults) {
   EXPECT_EQ(s.function_tolerance, library.solver.function_tolerance);
   EXPECT_EQ(s.gradient_tolerance, library.solver.gradient_tolerance);
   EXPECT_EQ(s.parameter_tolerance, library.solver.parameter_tolerance);
+  EXPECT_EQ(s.decrement_tolerance, library.solver.decrement_tolerance);
   EXPECT_EQ(s.max_memory_gb, library.solver.max_memory_gb);
 }
 
