@@ -53,7 +53,8 @@ bool BandedSolvable(const ceres::Problem& problem, const BandedColumns& columns,
       *why = "a parameter block has a manifold";
       return false;
     }
-    for (int i = 0; i < problem.ParameterBlockSize(block); ++i) {
+    const int size = problem.ParameterBlockSize(block);
+    for (int i = 0; i < size; ++i) {
       if (problem.GetParameterLowerBound(block, i) >
               -std::numeric_limits<double>::max() ||
           problem.GetParameterUpperBound(block, i) <
