@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <memory>
 #include <set>
 
 #include "glog/logging.h"
@@ -69,8 +70,8 @@ bool BandedSolvable(const ceres::Problem& problem, const BandedColumns& columns,
 
 void MinimizeBanded(const ceres::Solver::Options& options,
                     BandedProblem* banded, ceres::Problem* problem,
-                    ceres::Solver::Summary* summary,
-                    double decrement_tolerance) {
+                    ceres::Solver::Summary* summary, double decrement_tolerance,
+                    BandedLinearization* last) {
   CHECK(options.jacobi_scaling && !options.use_nonmonotonic_steps &&
         !options.use_inner_iterations)
       << "MinimizeBanded implements Ceres's default trust-region loop only";
@@ -91,6 +92,7 @@ void MinimizeBanded(const ceres::Solver::Options& options,
   summary->num_parameter_blocks_reduced = banded->num_variable_blocks();
   const Eigen::VectorXd start_values = banded->Gather();
   Eigen::VectorXd x = start_values, best = x, gradient(n);
+  std::unique_ptr<EnvelopeMatrix> hessian;  // H = J^T J at x.
   // Costs without the fixed cost, which the reported ones include.
   double cost = 0.0, fixed_cost = 0.0;
   auto finish = [&](ceres::TerminationType type, const std::string& message) {
@@ -98,6 +100,13 @@ void MinimizeBanded(const ceres::Solver::Options& options,
     summary->message = message;
     // As Ceres: a failed solve leaves the starting values.
     banded->Scatter(summary->IsSolutionUsable() ? best : start_values);
+    // H and g are those of x, the last point linearised.
+    if (last != nullptr && summary->IsSolutionUsable() && hessian &&
+        (x.array() == best.array()).all()) {
+      last->x = best;
+      last->gradient = gradient;
+      last->hessian = std::move(hessian);
+    }
     summary->final_cost = summary->initial_cost;
     for (const ceres::IterationSummary& i : summary->iterations) {
       summary->final_cost = std::min(summary->final_cost, i.cost);
@@ -115,14 +124,16 @@ void MinimizeBanded(const ceres::Solver::Options& options,
                   "Function tolerance reached. No non-constant parameter "
                   "blocks found.");
   }
-  EnvelopeMatrix hessian(banded->envelope_first());
+  hessian = std::make_unique<EnvelopeMatrix>(banded->envelope_first());
   EnvelopeMatrix system(banded->envelope_first());
-  if (!banded->Linearize(x, &cost, &gradient, &hessian)) {
+  if (!banded->Linearize(x, &cost, &gradient, hessian.get())) {
     return finish(ceres::FAILURE, "Residual and Jacobian evaluation failed.");
   }
   // Jacobi scaling from the first Jacobian, kept for the whole solve.
   Eigen::VectorXd scale(n);
-  for (int i = 0; i < n; ++i) scale[i] = 1.0 / (1.0 + std::sqrt(hessian(i, i)));
+  for (int i = 0; i < n; ++i) {
+    scale[i] = 1.0 / (1.0 + std::sqrt((*hessian)(i, i)));
+  }
   summary->initial_cost = cost + fixed_cost;
   double minimum_cost = std::numeric_limits<double>::infinity();
   // As Ceres: no parameter tolerance test before the first accepted step
@@ -223,9 +234,9 @@ void MinimizeBanded(const ceres::Solver::Options& options,
     // = -S g.
     Eigen::VectorXd damping(n);  // D, the diagonal added to S H S.
     for (int i = 0; i < n; ++i) {
-      const double* h = hessian.row(i);
+      const double* h = hessian->row(i);
       double* a = system.row(i);
-      const int f = hessian.first(i);
+      const int f = hessian->first(i);
       for (int j = f; j <= i; ++j) a[j - f] = h[j - f] * scale[i] * scale[j];
       damping[i] = std::clamp(a[i - f], options.min_lm_diagonal,
                               options.max_lm_diagonal) /
@@ -295,7 +306,7 @@ void MinimizeBanded(const ceres::Solver::Options& options,
     if (next.relative_decrease > options.min_relative_decrease) {
       x = candidate;
       x_norm = x.norm();
-      if (!banded->Linearize(x, &cost, &gradient, &hessian)) {
+      if (!banded->Linearize(x, &cost, &gradient, hessian.get())) {
         return finish(ceres::FAILURE,
                       "Residual and Jacobian evaluation failed.");
       }

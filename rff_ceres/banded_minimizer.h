@@ -34,11 +34,15 @@ bool BandedSolvable(const ceres::Problem& problem, const BandedColumns& columns,
 // iterations, which rff_slam never changes (checked). With
 // `decrement_tolerance` > 0 it also stops, converged, after a nearly
 // undamped step that the Gauss-Newton model valued below it (the cost's
-// units): Ceres has no such rule, so 0 keeps Ceres's steps exactly.
+// units): Ceres has no such rule, so 0 keeps Ceres's steps exactly. With
+// `last`, a usable solve leaves there its last linearisation, which is at
+// the values it writes back (every accepted step lowers the cost); `last`'s
+// `banded` is the caller's to set.
 void MinimizeBanded(const ceres::Solver::Options& options,
                     BandedProblem* banded, ceres::Problem* problem,
                     ceres::Solver::Summary* summary,
-                    double decrement_tolerance = 0.0);
+                    double decrement_tolerance = 0.0,
+                    BandedLinearization* last = nullptr);
 
 }  // namespace rff
 

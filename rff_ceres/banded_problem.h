@@ -6,6 +6,7 @@
 #define RFF_CERES_BANDED_PROBLEM_H_
 
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "Eigen/Core"
@@ -117,6 +118,15 @@ class BandedProblem {
   std::vector<std::vector<double>> jacobian_rows_;
   std::vector<double*> jacobian_pointers_;
   std::vector<double> residual_buffer_;  // The last term's residual.
+};
+
+// A layout with g = J^T r and H = J^T J accumulated at x (Linearize), as
+// a solve leaves them: the variance components and the convergence check
+// factorise that H rather than linearising the same point again.
+struct BandedLinearization {
+  std::unique_ptr<BandedProblem> banded;
+  Eigen::VectorXd x, gradient;
+  std::unique_ptr<EnvelopeMatrix> hessian;
 };
 
 }  // namespace rff

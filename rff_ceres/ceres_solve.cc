@@ -217,8 +217,13 @@ bool RunSolve(const SolverOptions& solver, ceres::Solver::Options ceres_options,
             "banded states: Levenberg-Marquardt on a Cholesky of the whole "
             "system in time order";
       }
+      BandedLinearization last;
       MinimizeBanded(ceres_options, banded.get(), problem->problem(),
-                     &result->summary, solver.decrement_tolerance);
+                     &result->summary, solver.decrement_tolerance, &last);
+      if (last.hessian) {
+        last.banded = std::move(banded);
+        problem->KeepLinearization(std::move(last));
+      }
       return CheckSolve(result->summary, problem, error);
     }
     if (asked) {

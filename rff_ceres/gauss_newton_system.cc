@@ -169,6 +169,16 @@ std::vector<int> TimeOrderPositions(SlamProblem* problem,
 
 bool FactorizeBanded(SlamProblem* problem, BandedSystem* system) {
   if (problem->model().HasDenseReducedSystem()) return false;
+  // The solve's own H at these values, when it left one: the same sums.
+  BandedLinearization kept;
+  if (problem->TakeLinearization(&kept) &&
+      EnvelopeAffordable(kept.banded->Size())) {
+    system->banded = std::move(kept.banded);
+    system->x = std::move(kept.x);
+    system->gradient = std::move(kept.gradient);
+    system->factor = std::move(kept.hessian);
+    return system->factor->Factorize();
+  }
   const BandedColumns columns = problem->BandColumns();
   std::string why;
   if (!BandedSolvable(*problem->problem(), columns, &why)) return false;

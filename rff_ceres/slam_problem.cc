@@ -478,4 +478,35 @@ BandedColumns SlamProblem::BandColumns() {
   return columns;
 }
 
+std::array<int, 3> SlamProblem::BlockCounts() const {
+  std::vector<double*> blocks;
+  problem_->GetParameterBlocks(&blocks);
+  int constant = 0;
+  for (double* block : blocks) {
+    constant += problem_->IsParameterBlockConstant(block) ? 1 : 0;
+  }
+  return {problem_->NumResidualBlocks(), static_cast<int>(blocks.size()),
+          constant};
+}
+
+void SlamProblem::KeepLinearization(BandedLinearization linearization) {
+  kept_ = std::move(linearization);
+  kept_counts_ = BlockCounts();
+}
+
+bool SlamProblem::TakeLinearization(BandedLinearization* linearization) {
+  BandedLinearization kept = std::move(kept_);
+  kept_ = BandedLinearization();
+  if (!kept.banded || !kept.hessian || BlockCounts() != kept_counts_) {
+    return false;
+  }
+  const Eigen::VectorXd values = kept.banded->Gather();
+  if (values.size() != kept.x.size() ||
+      (values.array() != kept.x.array()).any()) {
+    return false;
+  }
+  *linearization = std::move(kept);
+  return true;
+}
+
 }  // namespace rff

@@ -6,6 +6,7 @@
 #ifndef RFF_CERES_SLAM_PROBLEM_H_
 #define RFF_CERES_SLAM_PROBLEM_H_
 
+#include <array>
 #include <map>
 #include <memory>
 #include <set>
@@ -219,8 +220,18 @@ class SlamProblem {
   // trajectory blocks in the model's (time) order, the landmarks each placed
   // after its sightings, the shared blocks and calibrations last.
   BandedColumns BandColumns();
+  // What the last BANDED_CHOLESKY solve left (RunSolve): its layout and
+  // its linearisation at the values it wrote back, for FactorizeBanded.
+  void KeepLinearization(BandedLinearization linearization);
+  // Moves it into `linearization` while the problem has the same residual
+  // and parameter blocks, constant ones and values as when it was kept;
+  // false otherwise. None is kept after either way.
+  bool TakeLinearization(BandedLinearization* linearization);
 
  private:
+  // The blocks TakeLinearization checks: residual, parameter and constant
+  // parameter blocks.
+  std::array<int, 3> BlockCounts() const;
   // Parameter blocks of a cost over `maps` (model block ids rewritten to the
   // cost's local indices, in place), with `landmark` appended if non-null.
   std::vector<double*> LocalBlocks(std::vector<PoseMap*> maps,
@@ -258,6 +269,8 @@ class SlamProblem {
   // group by address: this keeps the solve's arithmetic reproducible).
   std::map<LandmarkId, int> slots_;
   std::vector<Eigen::Vector2d> storage_;
+  BandedLinearization kept_;
+  std::array<int, 3> kept_counts_{};
   std::set<LandmarkId> added_;
   std::set<LandmarkId> has_prior_;
   Eigen::Vector2d range_calibration_ = Eigen::Vector2d(1.0, 0.0);

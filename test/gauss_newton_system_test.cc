@@ -7,6 +7,7 @@
 
 #include "Eigen/Dense"
 #include "gtest/gtest.h"
+#include "rff_ceres/ceres_solve.h"
 #include "rff_ceres/mean/prior_mean.h"
 #include "rff_ceres/priors/trajectory_prior.h"
 #include "rff_ceres/simulate.h"
@@ -283,6 +284,95 @@ TEST(GaussNewtonDecreaseTest, IsTheDenseValueOrABoundBelowIt) {
     EXPECT_NEAR(decrease, dense, (prior == "wnoa" ? 1e-9 : 1e-3) * dense)
         << prior;
   }
+}
+
+// A WNOA problem solved with BANDED_CHOLESKY, which leaves its linearisation.
+struct SolvedWnoaProblem {
+  Dataset dataset;
+  std::unique_ptr<TrajectoryModel> model;
+  std::unique_ptr<SlamProblem> problem;
+  SolverOptions solver;
+  ceres::Solver::Options ceres_options;
+
+  void Solve() {
+    SlamResult result;
+    std::string error;
+    ASSERT_TRUE(RunSolve(solver, ceres_options, problem.get(), &result, &error))
+        << error;
+  }
+};
+
+std::unique_ptr<SolvedWnoaProblem> SolvedWnoa() {
+  auto solved = std::make_unique<SolvedWnoaProblem>();
+  SimulationOptions simulation = PaperOptions(6);
+  simulation.num_steps = 60;
+  simulation.num_landmarks = 12;
+  std::string error;
+  EXPECT_TRUE(Simulate(simulation, &solved->dataset, &error)) << error;
+  SlamOptions options;
+  options.prior = "wnoa";
+  const std::shared_ptr<const MeanFunction> mean =
+      BuildPriorMean("constant", solved->dataset, options.localization,
+                     kPaperSplineSmoothing, &error);
+  EXPECT_NE(mean, nullptr) << error;
+  solved->model = CreateTrajectoryModel(solved->dataset, options, mean, &error);
+  EXPECT_NE(solved->model, nullptr) << error;
+  std::map<LandmarkId, Eigen::Vector2d> landmarks;
+  for (const Landmark& l : solved->dataset.ground_truth_landmarks) {
+    landmarks[l.id] = Eigen::Vector2d(l.x + 0.3, l.y - 0.3);
+  }
+  solved->problem =
+      std::make_unique<SlamProblem>(solved->model.get(), options.problem);
+  EXPECT_TRUE(solved->problem->Build(solved->dataset, landmarks, &error))
+      << error;
+  solved->solver.linear_solver = "BANDED_CHOLESKY";
+  EXPECT_TRUE(ToCeresOptions(solved->solver, &solved->ceres_options, &error))
+      << error;
+  return solved;
+}
+
+void ExpectSameSystem(const BandedSystem& a, const BandedSystem& b) {
+  ASSERT_EQ(a.x.size(), b.x.size());
+  EXPECT_TRUE((a.x.array() == b.x.array()).all());
+  EXPECT_TRUE((a.gradient.array() == b.gradient.array()).all());
+  ASSERT_EQ(a.factor->num_entries(), b.factor->num_entries());
+  for (int i = 0; i < a.factor->size(); ++i) {
+    for (int j = a.factor->first(i); j <= i; ++j) {
+      ASSERT_EQ((*a.factor)(i, j), (*b.factor)(i, j)) << i << ", " << j;
+    }
+  }
+}
+
+// The solve's own H is the one a new linearisation at its values gives, bit
+// for bit; it is taken once, and only while values and blocks are the same.
+TEST(FactorizeBandedTest, TakesTheSolvesLinearizationOnlyWhileItHolds) {
+  const std::unique_ptr<SolvedWnoaProblem> solved = SolvedWnoa();
+  SlamProblem& problem = *solved->problem;
+  BandedLinearization taken;
+  EXPECT_FALSE(problem.TakeLinearization(&taken));  // Nothing solved yet.
+
+  solved->Solve();
+  BandedSystem kept, fresh;
+  ASSERT_TRUE(FactorizeBanded(&problem, &kept));
+  EXPECT_FALSE(problem.TakeLinearization(&taken));  // Taken by the first.
+  ASSERT_TRUE(FactorizeBanded(&problem, &fresh));
+  ExpectSameSystem(kept, fresh);
+
+  solved->Solve();
+  ASSERT_TRUE(problem.TakeLinearization(&taken));
+  ASSERT_NE(taken.hessian, nullptr);
+  EXPECT_TRUE((taken.x.array() == taken.banded->Gather().array()).all());
+
+  // Moved values, or a block held constant, leave it unused.
+  solved->Solve();
+  double* landmark =
+      problem.landmark_block(solved->dataset.ground_truth_landmarks.front().id);
+  ASSERT_NE(landmark, nullptr);
+  landmark[0] += 1e-3;
+  EXPECT_FALSE(problem.TakeLinearization(&taken));
+  solved->Solve();
+  problem.problem()->SetParameterBlockConstant(landmark);
+  EXPECT_FALSE(problem.TakeLinearization(&taken));
 }
 
 }  // namespace
