@@ -170,6 +170,7 @@ void SetOrdering(SlamProblem* problem, ceres::Solver::Options* options) {
 
 bool RunSolve(const SolverOptions& solver, ceres::Solver::Options ceres_options,
               SlamProblem* problem, SlamResult* result, std::string* error) {
+  problem->DropLinearization();
   const bool asked = IsBandedCholesky(solver.linear_solver);
   if (asked ||
       (solver.linear_solver == "auto" &&

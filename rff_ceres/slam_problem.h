@@ -227,6 +227,8 @@ class SlamProblem {
   // and parameter blocks, constant ones and values as when it was kept;
   // false otherwise. None is kept after either way.
   bool TakeLinearization(BandedLinearization* linearization);
+  // Frees it: a new solve must not hold an old H beside its own.
+  void DropLinearization() { kept_ = BandedLinearization(); }
 
  private:
   // The blocks TakeLinearization checks: residual, parameter and constant
