@@ -21,9 +21,11 @@ double Now() {
       .count();
 }
 
-// Trust radii from which the LM damping, the scaled diagonal / radius, is
-// too small to shorten a step noticeably.
+// A step counts as undamped for the decrement rule from this trust radius
+// (LM damping = scaled diagonal / radius) and while the damping's share
+// z^T D z of the model decrease's y^T y is below kMaxDampingShare.
 constexpr double kUndampedRadius = 1e8;
+constexpr double kMaxDampingShare = 1e-2;
 
 std::string MessageWith(const char* format, double a, double b) {
   char text[160];
@@ -147,9 +149,13 @@ void MinimizeBanded(const ceres::Solver::Options& options,
     decrease_factor *= 2.0;
   };
   int invalid_steps = 0;
-  // The Gauss-Newton decrease the last accepted step was predicted to make.
-  double accepted_model_decrease = std::numeric_limits<double>::infinity();
-  double accepted_radius = 0.0;  // The trust radius it was solved with.
+  // What the last accepted step leaves, by its predicted decrease m and its
+  // actual one rho m: along the step the cost's curvature is (2 - rho) times
+  // the model's, so a step of the right length would have gained
+  // m / (2 - rho), which bounds what is left after it. Infinite for a
+  // damped step or where the model's curvature is not the cost's (rho >= 2).
+  double accepted_remaining = std::numeric_limits<double>::infinity();
+  bool undamped = false;  // The step being solved.
   ceres::IterationSummary it;
   it.step_is_valid = it.step_is_successful = true;
   it.eta = options.eta;
@@ -206,16 +212,14 @@ void MinimizeBanded(const ceres::Solver::Options& options,
                       "%e <= %e",
                       it.gradient_max_norm, options.gradient_tolerance));
     }
-    // A nearly undamped step the model valued at less than the tolerance,
-    // taken: what is left is as small (Boyd and Vandenberghe 2004, 9.5.1,
-    // Newton's decrement). A damped step understates it.
-    if (it.step_is_successful && accepted_radius >= kUndampedRadius &&
-        accepted_model_decrease <= decrement_tolerance) {
+    // Newton's decrement as a stopping rule (Boyd and Vandenberghe 2004,
+    // 9.5.1), with the model's decrease corrected by the step's quality.
+    if (it.step_is_successful && accepted_remaining <= decrement_tolerance) {
       return finish(
           ceres::CONVERGENCE,
-          MessageWith("Gauss-Newton decrement tolerance reached. Predicted "
-                      "decrease of the last step: %e <= %e",
-                      accepted_model_decrease, decrement_tolerance));
+          MessageWith("Gauss-Newton decrement tolerance reached. Decrease "
+                      "left after the last step: %e <= %e",
+                      accepted_remaining, decrement_tolerance));
     }
     if (radius <= options.min_trust_region_radius) {
       return finish(
@@ -256,8 +260,10 @@ void MinimizeBanded(const ceres::Solver::Options& options,
       // a product with H: L L^T z = -S g gives -g^T dx = y^T y and
       // z^T S H S z = y^T y - z^T D z, so it is (y^T y + z^T D z) / 2, a sum
       // of squares (it assumes the solve's rounding, as Ceres's J dx does).
-      model_cost_change =
-          0.5 * (y.squaredNorm() + z.dot(damping.cwiseProduct(z)));
+      const double damped = z.dot(damping.cwiseProduct(z));
+      model_cost_change = 0.5 * (y.squaredNorm() + damped);
+      undamped = radius >= kUndampedRadius &&
+                 damped <= kMaxDampingShare * y.squaredNorm();
       valid = step.allFinite() && model_cost_change > 0.0;
     }
     next.step_solver_time_in_seconds = Now() - solve_start;
@@ -311,8 +317,10 @@ void MinimizeBanded(const ceres::Solver::Options& options,
                       "Residual and Jacobian evaluation failed.");
       }
       next.step_is_successful = true;
-      accepted_model_decrease = model_cost_change;
-      accepted_radius = radius;
+      accepted_remaining =
+          undamped && next.relative_decrease < 2.0
+              ? model_cost_change / (2.0 - next.relative_decrease)
+              : std::numeric_limits<double>::infinity();
       next.cost = cost + fixed_cost;
       next.gradient_max_norm = gradient.lpNorm<Eigen::Infinity>();
       next.gradient_norm = gradient.norm();

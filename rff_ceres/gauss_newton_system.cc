@@ -168,11 +168,12 @@ std::vector<int> TimeOrderPositions(SlamProblem* problem,
 }
 
 bool FactorizeBanded(SlamProblem* problem, BandedSystem* system) {
-  if (problem->model().HasDenseReducedSystem()) return false;
   // The solve's own H at these values, when it left one: the same sums.
+  // Taken first, so that it is freed whatever follows.
   BandedLinearization kept;
-  if (problem->TakeLinearization(&kept) &&
-      EnvelopeAffordable(kept.banded->Size())) {
+  const bool has_kept = problem->TakeLinearization(&kept);
+  if (problem->model().HasDenseReducedSystem()) return false;
+  if (has_kept && EnvelopeAffordable(kept.banded->Size())) {
     system->banded = std::move(kept.banded);
     system->x = std::move(kept.x);
     system->gradient = std::move(kept.gradient);

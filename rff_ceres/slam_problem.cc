@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <string_view>
 
 #include "Eigen/Eigenvalues"
@@ -478,33 +479,38 @@ BandedColumns SlamProblem::BandColumns() {
   return columns;
 }
 
-std::array<int, 3> SlamProblem::BlockCounts() const {
+bool SlamProblem::BlockState::operator==(const BlockState& other) const {
+  return num_residual_blocks == other.num_residual_blocks &&
+         blocks == other.blocks && values.size() == other.values.size() &&
+         (values.empty() || std::memcmp(values.data(), other.values.data(),
+                                        values.size() * sizeof(double)) == 0);
+}
+
+SlamProblem::BlockState SlamProblem::CurrentBlockState() const {
+  BlockState state;
+  state.num_residual_blocks = problem_->NumResidualBlocks();
   std::vector<double*> blocks;
   problem_->GetParameterBlocks(&blocks);
-  int constant = 0;
   for (double* block : blocks) {
-    constant += problem_->IsParameterBlockConstant(block) ? 1 : 0;
+    state.blocks.emplace_back(block, problem_->IsParameterBlockConstant(block));
+    const int size = problem_->ParameterBlockSize(block);
+    state.values.insert(state.values.end(), block, block + size);
   }
-  return {problem_->NumResidualBlocks(), static_cast<int>(blocks.size()),
-          constant};
+  return state;
 }
 
 void SlamProblem::KeepLinearization(BandedLinearization linearization) {
   kept_ = std::move(linearization);
-  kept_counts_ = BlockCounts();
+  kept_state_ = CurrentBlockState();
 }
 
 bool SlamProblem::TakeLinearization(BandedLinearization* linearization) {
   BandedLinearization kept = std::move(kept_);
   kept_ = BandedLinearization();
-  if (!kept.banded || !kept.hessian || BlockCounts() != kept_counts_) {
-    return false;
-  }
-  const Eigen::VectorXd values = kept.banded->Gather();
-  if (values.size() != kept.x.size() ||
-      (values.array() != kept.x.array()).any()) {
-    return false;
-  }
+  if (!kept.banded || !kept.hessian) return false;
+  const bool same = CurrentBlockState() == kept_state_;
+  kept_state_ = BlockState();
+  if (!same) return false;
   *linearization = std::move(kept);
   return true;
 }

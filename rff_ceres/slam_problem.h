@@ -6,12 +6,12 @@
 #ifndef RFF_CERES_SLAM_PROBLEM_H_
 #define RFF_CERES_SLAM_PROBLEM_H_
 
-#include <array>
 #include <map>
 #include <memory>
 #include <set>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "Eigen/Core"
@@ -223,17 +223,26 @@ class SlamProblem {
   // What the last BANDED_CHOLESKY solve left (RunSolve): its layout and
   // its linearisation at the values it wrote back, for FactorizeBanded.
   void KeepLinearization(BandedLinearization linearization);
-  // Moves it into `linearization` while the problem has the same residual
-  // and parameter blocks, constant ones and values as when it was kept;
-  // false otherwise. None is kept after either way.
+  // Moves it into `linearization` while the problem has the same number of
+  // residual blocks and the same parameter blocks, each as constant and
+  // with the same values, as when it was kept; false otherwise. None is
+  // kept after either way. Residuals changed another way (a cost or loss
+  // edited in place) go unseen: nothing here does that.
   bool TakeLinearization(BandedLinearization* linearization);
+  bool has_linearization() const { return kept_.hessian != nullptr; }
   // Frees it: a new solve must not hold an old H beside its own.
   void DropLinearization() { kept_ = BandedLinearization(); }
 
  private:
-  // The blocks TakeLinearization checks: residual, parameter and constant
-  // parameter blocks.
-  std::array<int, 3> BlockCounts() const;
+  // What TakeLinearization compares: the residual blocks' count, every
+  // parameter block (constant or not) and all their values.
+  struct BlockState {
+    int num_residual_blocks = 0;
+    std::vector<std::pair<const double*, bool>> blocks;
+    std::vector<double> values;
+    bool operator==(const BlockState& other) const;  // Values bit for bit.
+  };
+  BlockState CurrentBlockState() const;
   // Parameter blocks of a cost over `maps` (model block ids rewritten to the
   // cost's local indices, in place), with `landmark` appended if non-null.
   std::vector<double*> LocalBlocks(std::vector<PoseMap*> maps,
@@ -272,7 +281,7 @@ class SlamProblem {
   std::map<LandmarkId, int> slots_;
   std::vector<Eigen::Vector2d> storage_;
   BandedLinearization kept_;
-  std::array<int, 3> kept_counts_{};
+  BlockState kept_state_;
   std::set<LandmarkId> added_;
   std::set<LandmarkId> has_prior_;
   Eigen::Vector2d range_calibration_ = Eigen::Vector2d(1.0, 0.0);

@@ -294,11 +294,12 @@ struct SolvedWnoaProblem {
   SolverOptions solver;
   ceres::Solver::Options ceres_options;
 
-  void Solve() {
+  SlamResult Solve() {
     SlamResult result;
     std::string error;
-    ASSERT_TRUE(RunSolve(solver, ceres_options, problem.get(), &result, &error))
+    EXPECT_TRUE(RunSolve(solver, ceres_options, problem.get(), &result, &error))
         << error;
+    return result;
   }
 };
 
@@ -352,9 +353,10 @@ TEST(FactorizeBandedTest, TakesTheSolvesLinearizationOnlyWhileItHolds) {
   EXPECT_FALSE(problem.TakeLinearization(&taken));  // Nothing solved yet.
 
   solved->Solve();
+  ASSERT_TRUE(problem.has_linearization());
   BandedSystem kept, fresh;
   ASSERT_TRUE(FactorizeBanded(&problem, &kept));
-  EXPECT_FALSE(problem.TakeLinearization(&taken));  // Taken by the first.
+  EXPECT_FALSE(problem.has_linearization());  // Taken by the first.
   ASSERT_TRUE(FactorizeBanded(&problem, &fresh));
   ExpectSameSystem(kept, fresh);
 
@@ -363,16 +365,38 @@ TEST(FactorizeBandedTest, TakesTheSolvesLinearizationOnlyWhileItHolds) {
   ASSERT_NE(taken.hessian, nullptr);
   EXPECT_TRUE((taken.x.array() == taken.banded->Gather().array()).all());
 
-  // Moved values, or a block held constant, leave it unused.
-  solved->Solve();
+  // Moved values, a block held constant, or a constant block moved, leave
+  // it unused.
   double* landmark =
       problem.landmark_block(solved->dataset.ground_truth_landmarks.front().id);
   ASSERT_NE(landmark, nullptr);
-  landmark[0] += 1e-3;
-  EXPECT_FALSE(problem.TakeLinearization(&taken));
-  solved->Solve();
-  problem.problem()->SetParameterBlockConstant(landmark);
-  EXPECT_FALSE(problem.TakeLinearization(&taken));
+  for (const int change : {0, 1, 2}) {
+    solved->Solve();
+    ASSERT_TRUE(problem.has_linearization()) << change;
+    if (change == 0) landmark[0] += 1e-3;
+    if (change == 1) problem.problem()->SetParameterBlockConstant(landmark);
+    if (change == 2) landmark[1] += 1e-3;  // Constant since change 1.
+    EXPECT_FALSE(problem.TakeLinearization(&taken)) << change;
+    EXPECT_FALSE(problem.has_linearization()) << change;
+  }
+}
+
+// The tolerance reaches the loop from the solver options: with a large one
+// an early undamped step ends the solve, with 0 Ceres's rules do.
+TEST(FactorizeBandedTest, DecrementToleranceReachesTheBandedLoop) {
+  SlamResult result[2];
+  for (const int cut : {0, 1}) {
+    const std::unique_ptr<SolvedWnoaProblem> solved = SolvedWnoa();
+    solved->ceres_options.initial_trust_region_radius = 1e8;
+    solved->solver.decrement_tolerance = cut ? 1e9 : 0.0;
+    result[cut] = solved->Solve();
+  }
+  const std::string rule = "Gauss-Newton decrement tolerance reached";
+  EXPECT_NE(result[0].summary.message.rfind(rule, 0), 0u);
+  EXPECT_EQ(result[1].summary.message.rfind(rule, 0), 0u)
+      << result[1].summary.message;
+  EXPECT_LT(result[1].summary.num_successful_steps + 2,
+            result[0].summary.num_successful_steps);
 }
 
 }  // namespace
