@@ -190,9 +190,9 @@ DEFINE_double(gradient_tolerance, 1e-10,
 DEFINE_double(parameter_tolerance, 1e-8,
               "Ceres parameter tolerance, 0 or more.");
 DEFINE_double(decrement_tolerance, 0.01,
-              "BANDED_CHOLESKY: also converged once a nearly undamped step "
-              "is predicted by the Gauss-Newton model to lower the cost by "
-              "less than this, 0 or more; 0: Ceres's stopping rules only.");
+              "BANDED_CHOLESKY: also converged once an undamped step leaves "
+              "less than this to gain by the Gauss-Newton model (the cost's "
+              "units), 0 or more; 0: Ceres's stopping rules only.");
 
 namespace rff {
 namespace {

@@ -32,9 +32,10 @@ bool BandedSolvable(const ceres::Problem& problem, const BandedColumns& columns,
 // callbacks and update_state_every_iteration; it runs on one thread with
 // Ceres's defaults of Jacobi scaling, monotonic steps and no inner
 // iterations, which rff_slam never changes (checked). With
-// `decrement_tolerance` > 0 it also stops, converged, after a nearly
-// undamped step that the Gauss-Newton model valued below it (the cost's
-// units): Ceres has no such rule, so 0 keeps Ceres's steps exactly. With
+// `decrement_tolerance` > 0 it also stops, converged, after an undamped
+// step that leaves less than it to gain (the cost's units; its predicted
+// decrease over 2 - its quality): Ceres has no such rule, so 0 keeps
+// Ceres's steps exactly. With
 // `last`, a usable solve leaves there its last linearisation, which is at
 // the values it writes back (every accepted step lowers the cost); `last`'s
 // `banded` is the caller's to set.

@@ -34,8 +34,8 @@ struct SolverOptions {
   double function_tolerance = 1e-8;
   double gradient_tolerance = 1e-10;
   double parameter_tolerance = 1e-8;
-  // BANDED_CHOLESKY only: converged once a nearly undamped step is predicted
-  // to lower the cost by less than this (MinimizeBanded); 0: Ceres's rules.
+  // BANDED_CHOLESKY only: converged once an undamped step leaves less than
+  // this to gain (MinimizeBanded); 0: Ceres's rules.
   // 0.01 leaves the estimate within about sqrt(2 x 0.01) = 0.14 posterior
   // standard deviations of the minimum along the step.
   double decrement_tolerance = 0.01;
