@@ -1,6 +1,7 @@
 #include "rff_ceres/gauss_newton_system.h"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 #include <unordered_map>
 #include <utility>
@@ -202,11 +203,15 @@ constexpr int kMaxDecreaseIterations = 100;
 
 }  // namespace
 
-double GaussNewtonDecrease(SlamProblem* problem) {
+double GaussNewtonDecrease(SlamProblem* problem, bool* exact) {
   constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+  if (exact != nullptr) *exact = false;
   BandedSystem banded;
   if (FactorizeBanded(problem, &banded)) {
-    return 0.5 * banded.gradient.dot(banded.factor->Solve(banded.gradient));
+    const double decrease =
+        0.5 * banded.gradient.dot(banded.factor->Solve(banded.gradient));
+    if (exact != nullptr) *exact = std::isfinite(decrease);
+    return decrease;
   }
   std::vector<ceres::ResidualBlockId> ids;
   problem->problem()->GetResidualBlocks(&ids);

@@ -144,8 +144,10 @@ bool FactorizeBanded(SlamProblem* problem, BandedSystem* system);
 // whose estimate rises towards the value from below (Gauss quadrature:
 // Golub and Meurant 2010, 3.2), so no dense reduced system is factorised
 // for a check and a decrease it finds is there. NaN where it cannot tell
-// (an evaluation fails, H not positive definite).
-double GaussNewtonDecrease(SlamProblem* problem);
+// (an evaluation fails, H not positive definite). `exact`, when given, is
+// set to whether the value is the decrease itself (the envelope's) rather
+// than a bound or NaN.
+double GaussNewtonDecrease(SlamProblem* problem, bool* exact = nullptr);
 
 }  // namespace rff
 

@@ -49,7 +49,12 @@ QualityReport AssessQuality(
     const SolveFacts& facts) {
   QualityReport report;
   report.predicted_decrease = facts.predicted_decrease;
-  if (!facts.converged) {
+  // A solve cut off by its iteration or time limit stands where the exact
+  // Gauss-Newton decrease vouches for it, as a converged one does; a bound
+  // from below cannot.
+  const bool at_minimum = facts.predicted_decrease_exact &&
+                          facts.predicted_decrease <= kMaxPredictedDecrease;
+  if (!facts.converged && !at_minimum) {
     report.reasons.push_back("the solver stopped before convergence (" +
                              facts.termination + ")");
   }

@@ -65,6 +65,8 @@ struct SolveFacts {
   // g^T H^-1 g / 2, or a lower bound of it; NaN where it is not known (an
   // evaluation fails, H not positive definite, incremental updates).
   double predicted_decrease = 0.0;
+  // Whether predicted_decrease is the decrease itself, not a lower bound.
+  bool predicted_decrease_exact = false;
   // Range self-calibration: (scale, offset), (1, 0) when not estimated, and
   // whether a bound of slam_problem.h holds it.
   Eigen::Vector2d range_calibration = Eigen::Vector2d(1.0, 0.0);

@@ -171,9 +171,10 @@ bool ReportSolution(const SlamOptions& options,
   if (!problem->CheckLandmarksDetermined(1e12, error)) return false;
   // Judged against the data as stated: learned sigmas would absorb a misfit.
   SolveFacts facts = SolveFactsOf(*settled, *result);
-  facts.predicted_decrease = options.incremental.every == 0
-                                 ? GaussNewtonDecrease(problem)
-                                 : std::numeric_limits<double>::quiet_NaN();
+  facts.predicted_decrease =
+      options.incremental.every == 0
+          ? GaussNewtonDecrease(problem, &facts.predicted_decrease_exact)
+          : std::numeric_limits<double>::quiet_NaN();
   result->quality = AssessQuality(
       problem->WhitenedResidualsByKind(/*stated_sigmas=*/true), facts);
   for (const auto& [id, position] : landmarks) {

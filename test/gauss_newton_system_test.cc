@@ -276,7 +276,9 @@ TEST(GaussNewtonDecreaseTest, IsTheDenseValueOrABoundBelowIt) {
     const Eigen::MatrixXd j = sparse;
     const Eigen::VectorXd g = j.transpose() * residuals;
     const double dense = 0.5 * g.dot((j.transpose() * j).ldlt().solve(g));
-    const double decrease = GaussNewtonDecrease(&problem);
+    bool exact = true;
+    const double decrease = GaussNewtonDecrease(&problem, &exact);
+    EXPECT_EQ(exact, prior == "wnoa") << prior;
     std::printf("%s: %lld weights, decrease %.9g, dense %.9g\n", prior.c_str(),
                 static_cast<long long>(j.cols()), decrease, dense);
     EXPECT_GT(dense, 1.0) << prior;

@@ -110,6 +110,29 @@ TEST(QualityReportTest, UnconvergedSolveAndCalibrationAtItsBoundAreSuspect) {
                           "held by its bound"));
 }
 
+// A solve cut off by its iteration cap stands where the exact decrease
+// (banded states) vouches for it; a lower bound (feature models) does not.
+TEST(QualityReportTest, CutOffSolveAtItsMinimumByTheExactDecreaseIsOk) {
+  SolveFacts facts;
+  facts.converged = false;
+  facts.termination = "NO_CONVERGENCE";
+  facts.predicted_decrease = 0.0026;
+  facts.predicted_decrease_exact = true;
+  EXPECT_EQ(AssessQuality({}, facts).verdict, "ok");
+  facts.predicted_decrease_exact = false;
+  EXPECT_THAT(AssessQuality({}, facts).reasons,
+              ElementsAre("the solver stopped before convergence "
+                          "(NO_CONVERGENCE)"));
+  facts.predicted_decrease = 3.0;
+  facts.predicted_decrease_exact = true;
+  EXPECT_THAT(AssessQuality({}, facts).reasons,
+              ElementsAre("the solver stopped before convergence "
+                          "(NO_CONVERGENCE)",
+                          "the Gauss-Newton model still expects the cost to "
+                          "fall by 3 (more than 1): the solve stopped short "
+                          "of its minimum"));
+}
+
 // A solve that reports convergence with the Gauss-Newton model still
 // expecting more than kMaxPredictedDecrease is suspect; one unit less is
 // not, nor is an unknown (NaN) decrease.
