@@ -236,36 +236,53 @@ TEST(GaussNewtonSystemTest, SchurOnlyLeavesASystemWithoutTheFormUnfactorised) {
   EXPECT_TRUE(fallback.positive_definite());
 }
 
+// A 60-step run of the paper's simulation (seed `seed`, 12 landmarks) as
+// `options` model it around a constant mean, the landmarks started 0.3 m
+// off: built, nothing solved.
+struct SmallProblem {
+  Dataset dataset;
+  std::unique_ptr<TrajectoryModel> model;
+  std::unique_ptr<SlamProblem> problem;
+};
+
+void BuildSmallProblem(int seed, const SlamOptions& options,
+                       SmallProblem* built) {
+  SimulationOptions simulation = PaperOptions(seed);
+  simulation.num_steps = 60;
+  simulation.num_landmarks = 12;
+  std::string error;
+  ASSERT_TRUE(Simulate(simulation, &built->dataset, &error)) << error;
+  const std::shared_ptr<const MeanFunction> mean =
+      BuildPriorMean("constant", built->dataset, options.localization,
+                     kPaperSplineSmoothing, &error);
+  ASSERT_NE(mean, nullptr) << error;
+  built->model = CreateTrajectoryModel(built->dataset, options, mean, &error);
+  ASSERT_NE(built->model, nullptr) << error;
+  std::map<LandmarkId, Eigen::Vector2d> landmarks;
+  for (const Landmark& l : built->dataset.ground_truth_landmarks) {
+    landmarks[l.id] = Eigen::Vector2d(l.x + 0.3, l.y - 0.3);
+  }
+  built->problem =
+      std::make_unique<SlamProblem>(built->model.get(), options.problem);
+  ASSERT_TRUE(built->problem->Build(built->dataset, landmarks, &error))
+      << error;
+}
+
 // g^T H^-1 g / 2 away from the minimum (landmarks 0.3 m off, nothing
 // solved): WNOA states through the envelope give the dense value to
 // rounding; feature weights by conjugate gradients a lower bound, here
 // within 0.1% of it (measured 219.346 against 219.441: 100 steps in finite
 // precision on an ill-conditioned H).
 TEST(GaussNewtonDecreaseTest, IsTheDenseValueOrABoundBelowIt) {
-  SimulationOptions simulation = PaperOptions(4);
-  simulation.num_steps = 60;
-  simulation.num_landmarks = 12;
-  Dataset dataset;
-  std::string error;
-  ASSERT_TRUE(Simulate(simulation, &dataset, &error)) << error;
   for (const std::string prior : {"wnoa", "rff"}) {
     SlamOptions options;
     options.prior = prior;
     options.features.num_position_features = 12;
     options.features.num_heading_features = 12;
-    const std::shared_ptr<const MeanFunction> mean =
-        BuildPriorMean("constant", dataset, options.localization,
-                       kPaperSplineSmoothing, &error);
-    ASSERT_NE(mean, nullptr) << error;
-    const std::unique_ptr<TrajectoryModel> model =
-        CreateTrajectoryModel(dataset, options, mean, &error);
-    ASSERT_NE(model, nullptr) << error;
-    std::map<LandmarkId, Eigen::Vector2d> landmarks;
-    for (const Landmark& l : dataset.ground_truth_landmarks) {
-      landmarks[l.id] = Eigen::Vector2d(l.x + 0.3, l.y - 0.3);
-    }
-    SlamProblem problem(model.get(), options.problem);
-    ASSERT_TRUE(problem.Build(dataset, landmarks, &error)) << error;
+    SmallProblem built;
+    ASSERT_NO_FATAL_FAILURE(BuildSmallProblem(4, options, &built));
+    SlamProblem& problem = *built.problem;
+    std::string error;
     std::vector<ceres::ResidualBlockId> ids;
     problem.problem()->GetResidualBlocks(&ids);
     double cost = 0.0;
@@ -289,10 +306,7 @@ TEST(GaussNewtonDecreaseTest, IsTheDenseValueOrABoundBelowIt) {
 }
 
 // A WNOA problem solved with BANDED_CHOLESKY, which leaves its linearisation.
-struct SolvedWnoaProblem {
-  Dataset dataset;
-  std::unique_ptr<TrajectoryModel> model;
-  std::unique_ptr<SlamProblem> problem;
+struct SolvedWnoaProblem : SmallProblem {
   SolverOptions solver;
   ceres::Solver::Options ceres_options;
 
@@ -307,28 +321,11 @@ struct SolvedWnoaProblem {
 
 std::unique_ptr<SolvedWnoaProblem> SolvedWnoa() {
   auto solved = std::make_unique<SolvedWnoaProblem>();
-  SimulationOptions simulation = PaperOptions(6);
-  simulation.num_steps = 60;
-  simulation.num_landmarks = 12;
-  std::string error;
-  EXPECT_TRUE(Simulate(simulation, &solved->dataset, &error)) << error;
   SlamOptions options;
   options.prior = "wnoa";
-  const std::shared_ptr<const MeanFunction> mean =
-      BuildPriorMean("constant", solved->dataset, options.localization,
-                     kPaperSplineSmoothing, &error);
-  EXPECT_NE(mean, nullptr) << error;
-  solved->model = CreateTrajectoryModel(solved->dataset, options, mean, &error);
-  EXPECT_NE(solved->model, nullptr) << error;
-  std::map<LandmarkId, Eigen::Vector2d> landmarks;
-  for (const Landmark& l : solved->dataset.ground_truth_landmarks) {
-    landmarks[l.id] = Eigen::Vector2d(l.x + 0.3, l.y - 0.3);
-  }
-  solved->problem =
-      std::make_unique<SlamProblem>(solved->model.get(), options.problem);
-  EXPECT_TRUE(solved->problem->Build(solved->dataset, landmarks, &error))
-      << error;
+  BuildSmallProblem(6, options, solved.get());
   solved->solver.linear_solver = "BANDED_CHOLESKY";
+  std::string error;
   EXPECT_TRUE(ToCeresOptions(solved->solver, &solved->ceres_options, &error))
       << error;
   return solved;
@@ -350,6 +347,7 @@ void ExpectSameSystem(const BandedSystem& a, const BandedSystem& b) {
 // for bit; it is taken once, and only while values and blocks are the same.
 TEST(FactorizeBandedTest, TakesTheSolvesLinearizationOnlyWhileItHolds) {
   const std::unique_ptr<SolvedWnoaProblem> solved = SolvedWnoa();
+  ASSERT_NE(solved->problem, nullptr);
   SlamProblem& problem = *solved->problem;
   BandedLinearization taken;
   EXPECT_FALSE(problem.TakeLinearization(&taken));  // Nothing solved yet.
@@ -389,6 +387,7 @@ TEST(FactorizeBandedTest, DecrementToleranceReachesTheBandedLoop) {
   SlamResult result[2];
   for (const int cut : {0, 1}) {
     const std::unique_ptr<SolvedWnoaProblem> solved = SolvedWnoa();
+    ASSERT_NE(solved->problem, nullptr);
     solved->ceres_options.initial_trust_region_radius = 1e8;
     solved->solver.decrement_tolerance = cut ? 1e9 : 0.0;
     result[cut] = solved->Solve();
