@@ -86,7 +86,8 @@ bool SolveBatch(const Dataset& dataset, const SlamOptions& options,
     if (!(*problem)->Build(dataset, *landmarks, error)) return false;
     ChooseLinearSolver(options.solver, *model, &ceres_options, result);
     const bool solved =
-        RunSolve(options.solver, ceres_options, problem->get(), result, error);
+        RunSolve(options.solver, ceres_options, problem->get(), result, error,
+                 /*keep_linearization=*/true);
     VLOG(1) << result->summary.FullReport();
     if (!solved) return false;
     result->converged = result->summary.termination_type == ceres::CONVERGENCE;

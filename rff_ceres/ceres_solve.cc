@@ -169,7 +169,8 @@ void SetOrdering(SlamProblem* problem, ceres::Solver::Options* options) {
 }
 
 bool RunSolve(const SolverOptions& solver, ceres::Solver::Options ceres_options,
-              SlamProblem* problem, SlamResult* result, std::string* error) {
+              SlamProblem* problem, SlamResult* result, std::string* error,
+              bool keep_linearization) {
   problem->DropLinearization();
   const bool asked = IsBandedCholesky(solver.linear_solver);
   if (asked ||
@@ -220,7 +221,8 @@ bool RunSolve(const SolverOptions& solver, ceres::Solver::Options ceres_options,
       }
       BandedLinearization last;
       MinimizeBanded(ceres_options, banded.get(), problem->problem(),
-                     &result->summary, solver.decrement_tolerance, &last);
+                     &result->summary, solver.decrement_tolerance,
+                     keep_linearization ? &last : nullptr);
       if (last.hessian) {
         last.banded = std::move(banded);
         problem->KeepLinearization(std::move(last));

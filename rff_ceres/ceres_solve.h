@@ -68,9 +68,14 @@ void SetOrdering(SlamProblem* problem, ceres::Solver::Options* options);
 // bounds and a cheap factorisation (the choice and why then recorded in
 // `result`, after ChooseLinearSolver's, once per call); otherwise Ceres,
 // once the system is known to fit in memory. False with the cause in
-// `error` when it does not fit or the solve fails (CheckSolve).
+// `error` when it does not fit or the solve fails (CheckSolve). With
+// `keep_linearization` a BANDED_CHOLESKY solve leaves its last
+// linearisation in `problem` (SlamProblem::KeepLinearization) for the
+// variance components and the convergence check; the incremental updates,
+// which take none, skip the copy of the problem's state that costs.
 bool RunSolve(const SolverOptions& solver, ceres::Solver::Options ceres_options,
-              SlamProblem* problem, SlamResult* result, std::string* error);
+              SlamProblem* problem, SlamResult* result, std::string* error,
+              bool keep_linearization = false);
 
 // A solve is accepted only if Ceres did not fail and the cost is finite.
 // On failure the first non-finite residual is named, when there is one.

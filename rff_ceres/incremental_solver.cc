@@ -191,8 +191,6 @@ bool IncrementalSolver::Solve(std::string* error) {
       ceres_problem_->SetParameterBlockVariable(model_->mutable_block(b));
     }
   }
-  // Nothing takes the last update's H (no convergence check): free it.
-  slam_->DropLinearization();
   result_->converged = result_->summary.termination_type == ceres::CONVERGENCE;
   *landmarks_ = slam_->landmarks();
   result_->range_calibration = slam_->range_calibration();

@@ -313,7 +313,8 @@ struct SolvedWnoaProblem : SmallProblem {
   SlamResult Solve() {
     SlamResult result;
     std::string error;
-    EXPECT_TRUE(RunSolve(solver, ceres_options, problem.get(), &result, &error))
+    EXPECT_TRUE(RunSolve(solver, ceres_options, problem.get(), &result, &error,
+                         /*keep_linearization=*/true))
         << error;
     return result;
   }
@@ -351,6 +352,14 @@ TEST(FactorizeBandedTest, TakesTheSolvesLinearizationOnlyWhileItHolds) {
   SlamProblem& problem = *solved->problem;
   BandedLinearization taken;
   EXPECT_FALSE(problem.TakeLinearization(&taken));  // Nothing solved yet.
+  // A solve not asked to keep it (an incremental update) keeps none; asked
+  // (below), the same solve does.
+  SlamResult unkept;
+  std::string error;
+  ASSERT_TRUE(RunSolve(solved->solver, solved->ceres_options, &problem, &unkept,
+                       &error))
+      << error;
+  EXPECT_FALSE(problem.has_linearization());
 
   solved->Solve();
   ASSERT_TRUE(problem.has_linearization());
