@@ -73,10 +73,14 @@ BandedProblem::BandedProblem(const ceres::Problem& problem,
     variable_sizes_.push_back(size);
     num_columns_ += size;
   }
+  const std::unordered_set<const double*> timed(columns.timed.begin(),
+                                                columns.timed.end());
   for (double* block : blocks_) {
     const std::pair<int, int>& place = layout.at(block);
     columns_.push_back(place.first);
     sizes_.push_back(place.second);
+    in_panel_.push_back(place.first >= 0 && place.second >= kMinPanelWidth &&
+                        timed.count(block) > 0);
   }
   for (std::size_t r = 0; r < ids.size(); ++r) {
     Term term;
@@ -86,6 +90,9 @@ BandedProblem::BandedProblem(const ceres::Problem& problem,
     term.blocks = blocks_.data() + begin[r];
     term.column = columns_.data() + begin[r];
     term.size = sizes_.data() + begin[r];
+    term.in_panel = in_panel_.data() + begin[r];
+    term.num_panel_blocks = static_cast<int>(
+        std::count(term.in_panel, term.in_panel + term.num_blocks, 1));
     term.first_row = num_rows_;
     num_rows_ += term.cost->num_residuals();
     const bool variable =
@@ -167,12 +174,16 @@ bool BandedProblem::Linearize(const Eigen::VectorXd& x, double* cost,
   *cost = 0.0;
   g->setZero(num_columns_);
   h->SetZero();
+  panel_rows_ = 0;
+  panel_columns_.clear();
+  panel_sizes_.clear();
   for (const Term& term : terms_) {
     double term_cost;
     if (!Evaluate(term, x, /*jacobians=*/true, &term_cost)) return false;
     *cost += term_cost;
     Accumulate(term, g, h);
   }
+  FlushPanel(h);
   return true;
 }
 
@@ -260,9 +271,39 @@ bool BandedProblem::Evaluate(const Term& term, const Eigen::VectorXd& x,
 }
 
 void BandedProblem::Accumulate(const Term& term, Eigen::VectorXd* g,
-                               EnvelopeMatrix* h) const {
+                               EnvelopeMatrix* h) {
   const int rows = static_cast<int>(residual_buffer_.size());
   const double* residual = residual_buffer_.data();
+  if (term.num_panel_blocks > 0) {
+    // The term's rows join the panel if it is on the same blocks.
+    bool same =
+        panel_rows_ < kMaxPanelRows &&
+        static_cast<int>(panel_columns_.size()) == term.num_panel_blocks;
+    for (int a = 0, p = 0; same && a < term.num_blocks; ++a) {
+      if (term.in_panel[a]) same = panel_columns_[p++] == term.column[a];
+    }
+    if (!same) {
+      FlushPanel(h);
+      for (int a = 0; a < term.num_blocks; ++a) {
+        if (!term.in_panel[a]) continue;
+        panel_columns_.push_back(term.column[a]);
+        panel_sizes_.push_back(term.size[a]);
+      }
+    }
+    int width = 0;
+    for (const int s : panel_sizes_) width += s;
+    panel_.resize(static_cast<std::size_t>(panel_rows_ + rows) * width);
+    for (int k = 0; k < rows; ++k) {
+      double* out =
+          panel_.data() + static_cast<std::size_t>(panel_rows_ + k) * width;
+      for (int a = 0; a < term.num_blocks; ++a) {
+        if (!term.in_panel[a]) continue;
+        const double* j = jacobian_rows_[a].data() + k * term.size[a];
+        out = std::copy(j, j + term.size[a], out);
+      }
+    }
+    panel_rows_ += rows;
+  }
   for (int a = 0; a < term.num_blocks; ++a) {
     if (term.column[a] < 0) continue;
     const double* ja = jacobian_rows_[a].data();
@@ -272,7 +313,9 @@ void BandedProblem::Accumulate(const Term& term, Eigen::VectorXd* g,
     }
     for (int b = 0; b < term.num_blocks; ++b) {
       const int cb = term.column[b];
-      if (cb < 0 || cb > ca) continue;
+      if (cb < 0 || cb > ca || (term.in_panel[a] && term.in_panel[b])) {
+        continue;
+      }
       const double* jb = jacobian_rows_[b].data();
       const int sb = term.size[b];
       for (int i = 0; i < sa; ++i) {
@@ -286,6 +329,41 @@ void BandedProblem::Accumulate(const Term& term, Eigen::VectorXd* g,
       }
     }
   }
+}
+
+void BandedProblem::FlushPanel(EnvelopeMatrix* h) {
+  if (panel_rows_ > 0) {
+    const int blocks = static_cast<int>(panel_columns_.size());
+    std::vector<int> offset(blocks + 1, 0);
+    for (int p = 0; p < blocks; ++p)
+      offset[p + 1] = offset[p] + panel_sizes_[p];
+    const Eigen::Map<const EnvelopeMatrix::RowMajorMatrix> panel(
+        panel_.data(), panel_rows_, offset[blocks]);
+    Eigen::MatrixXd product;
+    for (int a = 0; a < blocks; ++a) {
+      const int ca = panel_columns_[a], sa = panel_sizes_[a];
+      for (int b = 0; b < blocks; ++b) {
+        const int cb = panel_columns_[b], sb = panel_sizes_[b];
+        if (cb > ca) continue;
+        if (a == b) {  // The lower triangle only (SYRK).
+          product.setZero(sa, sa);
+          product.selfadjointView<Eigen::Lower>().rankUpdate(
+              panel.middleCols(offset[a], sa).transpose());
+        } else {
+          product.noalias() = panel.middleCols(offset[a], sa).transpose() *
+                              panel.middleCols(offset[b], sb);
+        }
+        for (int i = 0; i < sa; ++i) {
+          double* hi = &(*h)(ca + i, cb);
+          const int width = a == b ? i + 1 : sb;
+          for (int j = 0; j < width; ++j) hi[j] += product(i, j);
+        }
+      }
+    }
+  }
+  panel_rows_ = 0;
+  panel_columns_.clear();
+  panel_sizes_.clear();
 }
 
 }  // namespace rff

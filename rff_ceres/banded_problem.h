@@ -31,6 +31,13 @@ struct BandedColumns {
 std::vector<double*> BandedBlockOrder(const ceres::Problem& problem,
                                       const BandedColumns& columns);
 
+// Timed blocks at least this wide (a feature window's 3 D weights) have
+// their products with each other formed a panel of rows at a time (BLAS-3);
+// WNOA's 6-wide states gain nothing from it (bench/README.md).
+inline constexpr int kMinPanelWidth = 12;
+// Rows a panel holds before it is multiplied out.
+inline constexpr int kMaxPanelRows = 256;
+
 // The envelope of H in a column order: its columns (the variables), the
 // doubles it stores and the multiply-adds of one factorisation.
 struct BandedSize {
@@ -94,6 +101,10 @@ class BandedProblem {
     const int* column = nullptr;
     const int* size = nullptr;
     int first_row = 0;  // Among the problem's residual rows.
+    // Per block: whether it is a wide timed variable, whose products with
+    // the term's other such blocks go through the panel.
+    const char* in_panel = nullptr;
+    int num_panel_blocks = 0;
   };
 
   std::vector<int> EnvelopeFirst() const;
@@ -102,14 +113,19 @@ class BandedProblem {
   bool Evaluate(const Term& term, const Eigen::VectorXd& x, bool jacobians,
                 double* cost);
   // g += J^T r and the lower triangle of H += J^T J, block pair by pair,
-  // from the last Evaluate.
-  void Accumulate(const Term& term, Eigen::VectorXd* g,
-                  EnvelopeMatrix* h) const;
+  // from the last Evaluate; the products among a term's panel blocks are
+  // deferred to the panel (FlushPanel).
+  void Accumulate(const Term& term, Eigen::VectorXd* g, EnvelopeMatrix* h);
+  // H += P_a^T P_b for the panel's block pairs: consecutive terms on the
+  // same wide blocks (a feature window's observations) as one BLAS-3
+  // product instead of a rank-one update per row.
+  void FlushPanel(EnvelopeMatrix* h);
 
   std::vector<double*> variables_;  // In column order, with their sizes.
   std::vector<int> variable_sizes_;
   std::vector<double*> blocks_;  // Every term's blocks, columns and sizes.
   std::vector<int> columns_, sizes_;
+  std::vector<char> in_panel_;
   std::vector<Term> terms_, fixed_terms_;
   int num_columns_ = 0;
   int num_rows_ = 0;
@@ -118,6 +134,11 @@ class BandedProblem {
   std::vector<std::vector<double>> jacobian_rows_;
   std::vector<double*> jacobian_pointers_;
   std::vector<double> residual_buffer_;  // The last term's residual.
+  // The panel: rows of the terms on `panel_columns_` (their first columns;
+  // widths `panel_sizes_`), row-major, panel_rows_ of them.
+  std::vector<int> panel_columns_, panel_sizes_;
+  std::vector<double> panel_;
+  int panel_rows_ = 0;
 };
 
 // A layout with g = J^T r and H = J^T J accumulated at x (Linearize), as
