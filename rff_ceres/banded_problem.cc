@@ -93,6 +93,7 @@ BandedProblem::BandedProblem(const ceres::Problem& problem,
     term.in_panel = in_panel_.data() + begin[r];
     term.num_panel_blocks = static_cast<int>(
         std::count(term.in_panel, term.in_panel + term.num_blocks, 1));
+    has_panels_ = has_panels_ || term.num_panel_blocks > 0;
     term.first_row = num_rows_;
     num_rows_ += term.cost->num_residuals();
     const bool variable =

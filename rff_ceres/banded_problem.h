@@ -55,6 +55,9 @@ class BandedProblem {
   BandedProblem(const ceres::Problem& problem, const BandedColumns& columns);
 
   int num_columns() const { return num_columns_; }
+  // Whether some residual has wide timed blocks (kMinPanelWidth): their
+  // products are formed a panel at a time.
+  bool has_panels() const { return has_panels_; }
   int num_variable_blocks() const {
     return static_cast<int>(variables_.size());
   }
@@ -129,6 +132,7 @@ class BandedProblem {
   std::vector<Term> terms_, fixed_terms_;
   int num_columns_ = 0;
   int num_rows_ = 0;
+  bool has_panels_ = false;
   std::vector<int> envelope_first_;
   std::vector<const double*> parameters_;
   std::vector<std::vector<double>> jacobian_rows_;

@@ -202,9 +202,12 @@ bool RunSolve(const SolverOptions& solver, ceres::Solver::Options ceres_options,
                       "%.3g GB allowed by --max_memory_gb",
                       bytes / 1e9, limit / 1e9);
         why = text;
-      } else if (!asked && work > kMaxEnvelopeWorkPerVariable) {
+      } else if (!asked && !banded->has_panels() &&
+                 work > kMaxEnvelopeWorkPerVariable) {
         // Landmarks seen over long stretches fill their rows of the factor;
-        // a fill-reducing sparse Cholesky then does better.
+        // a fill-reducing sparse Cholesky then does better on narrow
+        // states. Feature windows' J^T J costs Ceres more than the fill
+        // (envelope_cholesky.h).
         std::snprintf(text, sizeof(text),
                       "%.0f multiply-adds per variable in its factorisation, "
                       "more than %.0f",

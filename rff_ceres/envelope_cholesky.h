@@ -15,10 +15,12 @@
 namespace rff {
 
 // Up to this many multiply-adds per variable in Factorize, an envelope
-// beats a fill-reducing sparse Cholesky on our systems; beyond it, landmarks
-// seen again after long stretches fill the envelope (whole WNOA solves
-// against CHOLMOD: 0.8x at 220-944, 0.13x at 2794; 1.27x at 3313, 2.7x at
-// 13635; bench/README.md, "BANDED_CHOLESKY").
+// beats a fill-reducing sparse Cholesky on our systems of narrow states;
+// beyond it, landmarks seen again after long stretches fill the envelope
+// (whole WNOA solves against CHOLMOD: 0.8x at 220-944, 0.13x at 2794;
+// 1.27x at 3313, 2.7x at 13635; bench/README.md, "BANDED_CHOLESKY"). Feature
+// windows, whose J^T J the envelope forms a panel at a time, beat CHOLMOD
+// at any fill measured (0.25-0.7x at 9k-351k; bench/README.md).
 constexpr double kMaxEnvelopeWorkPerVariable = 3000.0;
 
 class EnvelopeMatrix {
