@@ -169,18 +169,18 @@ std::vector<int> TimeOrderPositions(SlamProblem* problem,
 }
 
 bool FactorizeBanded(SlamProblem* problem, BandedSystem* system) {
-  // The solve's own H at these values, when it left one: the same sums.
-  // Taken first, so that it is freed whatever follows.
+  // The solve's own H at these values, when it left one: the same sums, and
+  // affordable, as the solve factorised it at every step (feature windows
+  // too, which auto solves banded at any fill).
   BandedLinearization kept;
-  const bool has_kept = problem->TakeLinearization(&kept);
-  if (problem->model().HasDenseReducedSystem()) return false;
-  if (has_kept && EnvelopeAffordable(kept.banded->Size())) {
+  if (problem->TakeLinearization(&kept)) {
     system->banded = std::move(kept.banded);
     system->x = std::move(kept.x);
     system->gradient = std::move(kept.gradient);
     system->factor = std::move(kept.hessian);
     return system->factor->Factorize();
   }
+  if (problem->model().HasDenseReducedSystem()) return false;
   const BandedColumns columns = problem->BandColumns();
   std::string why;
   if (!BandedSolvable(*problem->problem(), columns, &why)) return false;

@@ -126,9 +126,10 @@ class GaussNewtonSystem {
 // H of a banded-state `problem` at its current values, accumulated from its
 // residual blocks in the time-ordered envelope BANDED_CHOLESKY factorises,
 // and factorised: `banded` the problem's layout, `x` its values, `gradient`
-// J^T r. False for a model with a dense reduced system (features) and
-// where the envelope does not serve (bounds, manifolds, too costly, or H
-// not positive definite to rounding).
+// J^T r; the H a BANDED_CHOLESKY solve kept at these values when there is
+// one (any model). False otherwise for a model with a dense reduced system
+// (features) and where the envelope does not serve (bounds, manifolds, too
+// costly, or H not positive definite to rounding).
 struct BandedSystem {
   std::unique_ptr<BandedProblem> banded;
   Eigen::VectorXd x, gradient;
@@ -138,8 +139,9 @@ bool FactorizeBanded(SlamProblem* problem, BandedSystem* system);
 
 // g^T H^-1 g / 2 at the problem's values, g = J^T r and H = J^T J of its
 // whitened, loss-corrected residuals: what the Gauss-Newton model still
-// expects to gain (a minimum leaves nothing). Banded states solve with H's
-// envelope factor (FactorizeBanded); other models take at most 100 steps
+// expects to gain (a minimum leaves nothing). Banded states, and any model
+// a BANDED_CHOLESKY solve left its H for, solve with H's envelope factor
+// (FactorizeBanded); other models take at most 100 steps
 // of conjugate gradients on J^T J with H's diagonal as preconditioner,
 // whose estimate rises towards the value from below (Gauss quadrature:
 // Golub and Meurant 2010, 3.2), so no dense reduced system is factorised

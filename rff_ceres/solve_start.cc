@@ -58,6 +58,12 @@ bool InitializeBlocks(const Dataset& start, const SlamOptions& options,
     result->initial_trajectory = "dead reckoning";
     return true;
   }
+  if (result->prior_mean == "localization") {
+    // The mean is the pilot, localised from the same data with the same
+    // options: the model starts on it with its blocks at zero.
+    result->initial_trajectory = "localization";
+    return true;
+  }
   std::vector<TimedPose> pilot;
   std::string why;
   if (!BuildPilotTrajectory(start, options.localization, OutputTimes(start),

@@ -30,7 +30,7 @@ std::shared_ptr<const MeanFunction> BuildMean(
 // The blocks start (initial_trajectory "auto") at dead reckoning about a
 // constant mean with odometry, else at the fit of the pilot trajectory when
 // there is one, else at zero (the prior mean). A "wnoa" mean is already a
-// solve of the data: it is the start.
+// solve of the data, and a "localization" mean the pilot: the start.
 bool InitializeBlocks(const Dataset& start, const SlamOptions& options,
                       TrajectoryModel* model, SlamResult* result,
                       std::string* error);

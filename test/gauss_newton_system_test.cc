@@ -409,5 +409,76 @@ TEST(FactorizeBandedTest, DecrementToleranceReachesTheBandedLoop) {
             result[0].summary.num_successful_steps);
 }
 
+// Feature windows solved by BANDED_CHOLESKY leave their H too: the
+// decrease is then exact (the dense value to rounding, where the conjugate
+// gradients give a bound), and the variance components' traces come from
+// the same probes through the envelope as through the sparse path.
+TEST(FactorizeBandedTest, FeatureWindowsSolvedBandedLeaveTheirH) {
+  SlamOptions options;
+  options.prior = "rff";
+  options.features.num_position_features = 12;
+  options.features.num_heading_features = 12;
+  options.features.segment_length = 20.0;  // Three windows of 60 s.
+  options.features.segment_overlap = 6.0;
+  SmallProblem built;
+  ASSERT_NO_FATAL_FAILURE(BuildSmallProblem(4, options, &built));
+  SlamProblem& problem = *built.problem;
+  SolverOptions solver;
+  solver.linear_solver = "BANDED_CHOLESKY";
+  solver.max_iterations = 2;  // Short of the minimum: a decrease is left.
+  ceres::Solver::Options ceres_options;
+  std::string error;
+  ASSERT_TRUE(ToCeresOptions(solver, &ceres_options, &error)) << error;
+  auto solve = [&] {
+    SlamResult result;
+    EXPECT_TRUE(RunSolve(solver, ceres_options, &problem, &result, &error,
+                         /*keep_linearization=*/true))
+        << error;
+  };
+  solve();
+  ASSERT_TRUE(problem.has_linearization());
+
+  std::vector<ceres::ResidualBlockId> ids;
+  problem.problem()->GetResidualBlocks(&ids);
+  double cost = 0.0;
+  Eigen::VectorXd residuals;
+  RowMajorSparse sparse;
+  ASSERT_TRUE(
+      Linearize(problem.problem(), ids, &cost, &residuals, &sparse, &error));
+  const Eigen::MatrixXd j = sparse;
+  const Eigen::VectorXd g = j.transpose() * residuals;
+  const double dense = 0.5 * g.dot((j.transpose() * j).ldlt().solve(g));
+  bool exact = false;
+  const double decrease = GaussNewtonDecrease(&problem, &exact);
+  EXPECT_TRUE(exact);
+  EXPECT_GT(dense, 1.0);
+  EXPECT_NEAR(decrease, dense, 1e-9 * dense);
+  // Without the kept H the feature model is back to the bound.
+  GaussNewtonDecrease(&problem, &exact);
+  EXPECT_FALSE(exact);
+
+  solve();
+  ASSERT_TRUE(problem.has_linearization());
+  VarianceComponents banded, through_sparse;
+  ASSERT_TRUE(EstimateVarianceComponents(&problem, VarianceComponentOptions(),
+                                         &banded, &error))
+      << error;
+  EXPECT_FALSE(problem.has_linearization());  // The envelope took it.
+  ASSERT_TRUE(EstimateVarianceComponents(&problem, VarianceComponentOptions(),
+                                         &through_sparse, &error))
+      << error;
+  int estimated = 0;
+  for (int group = 0; group < kNumVarianceGroups; ++group) {
+    const VarianceComponent& a = banded[group];
+    const VarianceComponent& b = through_sparse[group];
+    EXPECT_EQ(a.rows, b.rows) << group;
+    EXPECT_NEAR(a.sum_squares, b.sum_squares, 1e-9 * (1.0 + b.sum_squares))
+        << group;
+    EXPECT_NEAR(a.redundancy, b.redundancy, 1e-9 * (1.0 + b.rows)) << group;
+    estimated += b.estimated;
+  }
+  EXPECT_GE(estimated, 2);
+}
+
 }  // namespace
 }  // namespace rff
