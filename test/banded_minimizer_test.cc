@@ -1,6 +1,7 @@
 #include "rff_ceres/banded_minimizer.h"
 
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <vector>
 
@@ -517,6 +518,30 @@ TEST(BandedMinimizerTest, PanelProductsAreThoseOfTheJacobian) {
     for (int j = 0; j < banded.num_columns(); ++j) {
       const double stored = j >= h.first(i) && j <= i ? h(i, j) : 0.0;
       if (j <= i) EXPECT_NEAR(stored, expected_h(i, j), 1e-12 * scale) << i;
+    }
+  }
+}
+
+// A linearisation that fails part way (a weight of the last window not
+// finite) leaves rows in the panel; the next one starts clean: the same H
+// and g bit for bit as a layout that never failed.
+TEST(BandedMinimizerTest, APanelLeftByAFailedLinearizationIsDropped) {
+  WindowProblem windows(6, 40);
+  BandedProblem banded(*windows.problem, windows.Columns()),
+      clean(*windows.problem, windows.Columns());
+  const Eigen::VectorXd x = banded.Gather();
+  Eigen::VectorXd bad = x, g, expected_g;
+  bad[5 * 12] = std::numeric_limits<double>::quiet_NaN();
+  EnvelopeMatrix h(banded.envelope_first()), expected_h(clean.envelope_first());
+  double cost, expected_cost;
+  ASSERT_FALSE(banded.Linearize(bad, &cost, &g, &h));
+  ASSERT_TRUE(banded.Linearize(x, &cost, &g, &h));
+  ASSERT_TRUE(clean.Linearize(x, &expected_cost, &expected_g, &expected_h));
+  EXPECT_EQ(cost, expected_cost);
+  EXPECT_TRUE((g.array() == expected_g.array()).all());
+  for (int i = 0; i < h.size(); ++i) {
+    for (int j = h.first(i); j <= i; ++j) {
+      ASSERT_EQ(h(i, j), expected_h(i, j)) << i << ", " << j;
     }
   }
 }
