@@ -303,9 +303,8 @@ TEST(GaussNewtonDecreaseTest, IsTheDenseValueOrABoundBelowIt) {
     bool exact = true;
     const double decrease = GaussNewtonDecrease(&problem, &exact);
     EXPECT_EQ(exact, prior == "wnoa") << prior;
-    std::printf("%s: %d parameters, decrease %.9g, dense %.9g\n",
-                prior.c_str(), problem.problem()->NumParameters(), decrease,
-                dense);
+    std::printf("%s: %d parameters, decrease %.9g, dense %.9g\n", prior.c_str(),
+                problem.problem()->NumParameters(), decrease, dense);
     EXPECT_GT(dense, 1.0) << prior;
     EXPECT_LE(decrease, dense * (1.0 + 1e-9)) << prior;
     EXPECT_NEAR(decrease, dense, (prior == "wnoa" ? 1e-9 : 1e-3) * dense)
