@@ -37,17 +37,32 @@ constexpr double kHeadingHalfWindow = 5.0;
 constexpr double kMinHeadingTravel = 0.5;
 constexpr double kTravelHeadingVariance = 0.1;
 
-}  // namespace
+// An observation with its landmark found: a fix's refinement evaluates
+// the same observations at every step.
+struct MapObservation {
+  const Observation* observation;
+  const KnownLandmark* landmark;
+};
 
-std::vector<MapResidualRow> MapResiduals(
+std::vector<MapObservation> FindLandmarks(
     const std::vector<Observation>& observations,
-    const std::map<LandmarkId, KnownLandmark>& landmarks,
-    const Eigen::Vector3d& p) {
-  std::vector<MapResidualRow> rows;
+    const std::map<LandmarkId, KnownLandmark>& landmarks) {
+  std::vector<MapObservation> found;
+  found.reserve(observations.size());
   for (const Observation& o : observations) {
     const auto known = landmarks.find(o.id);
-    if (known == landmarks.end()) continue;
-    const KnownLandmark& l = known->second;
+    if (known != landmarks.end()) found.push_back({&o, &known->second});
+  }
+  return found;
+}
+
+// MapResiduals' rows of `observations` at `p`, into `rows`.
+void AppendMapResiduals(const std::vector<MapObservation>& observations,
+                        const Eigen::Vector3d& p,
+                        std::vector<MapResidualRow>* rows) {
+  for (const auto& [observation, landmark] : observations) {
+    const Observation& o = *observation;
+    const KnownLandmark& l = *landmark;
     // The measurement models of the solver's costs (costs/range_cost.h,
     // costs/bearing_cost.h), with the landmark's prior spread added.
     double range;
@@ -60,7 +75,7 @@ std::vector<MapResidualRow> MapResiduals(
       MapResidualRow row;
       row.residual = (range - o.range) / sigma;
       row.jacobian = d_pose.transpose() / sigma;
-      rows.push_back(row);
+      rows->push_back(row);
     }
     double bearing;
     if (!o.HasBearing()) continue;
@@ -73,8 +88,18 @@ std::vector<MapResidualRow> MapResiduals(
       row.residual = WrapAngle(bearing - o.bearing) / sigma;
       row.jacobian = d_pose.transpose() / sigma;
     }
-    rows.push_back(row);
+    rows->push_back(row);
   }
+}
+
+}  // namespace
+
+std::vector<MapResidualRow> MapResiduals(
+    const std::vector<Observation>& observations,
+    const std::map<LandmarkId, KnownLandmark>& landmarks,
+    const Eigen::Vector3d& p) {
+  std::vector<MapResidualRow> rows;
+  AppendMapResiduals(FindLandmarks(observations, landmarks), p, &rows);
   return rows;
 }
 
@@ -102,8 +127,7 @@ class PoseFit {
   PoseFit(const std::vector<Observation>& observations,
           const std::map<LandmarkId, KnownLandmark>& landmarks,
           const Eigen::Vector3d& start)
-      : observations_(observations),
-        landmarks_(landmarks),
+      : observations_(FindLandmarks(observations, landmarks)),
         start_(start),
         num_rows_(static_cast<int>(
             MapResiduals(observations, landmarks, start).size())) {}
@@ -118,14 +142,14 @@ class PoseFit {
                   std::numeric_limits<double>::quiet_NaN());
       return false;
     }
-    const std::vector<MapResidualRow> rows =
-        MapResiduals(observations_, landmarks_, pose);
-    DCHECK_EQ(static_cast<int>(rows.size()), num_rows_);
+    rows_.clear();
+    AppendMapResiduals(observations_, pose, &rows_);
+    DCHECK_EQ(static_cast<int>(rows_.size()), num_rows_);
     for (int r = 0; r < num_rows_; ++r) {
-      residuals[r] = rows[r].residual;
+      residuals[r] = rows_[r].residual;
       if (jacobian == nullptr) continue;
       for (int c = 0; c < kFree; ++c) {
-        jacobian[r + c * num_rows_] = rows[r].jacobian(c);  // Column-major.
+        jacobian[r + c * num_rows_] = rows_[r].jacobian(c);  // Column-major.
       }
     }
     return true;
@@ -138,10 +162,10 @@ class PoseFit {
   }
 
  private:
-  const std::vector<Observation>& observations_;
-  const std::map<LandmarkId, KnownLandmark>& landmarks_;
+  const std::vector<MapObservation> observations_;
   const Eigen::Vector3d start_;
   const int num_rows_;
+  mutable std::vector<MapResidualRow> rows_;  // Kept between steps.
 };
 
 // A fit of two or three unknowns converges in a few steps from a seed in its
