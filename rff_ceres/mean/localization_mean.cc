@@ -56,6 +56,15 @@ std::vector<MapObservation> FindLandmarks(
   return found;
 }
 
+// MapResiduals' row count: one per measured value, whatever the pose.
+int MapRowCount(const std::vector<MapObservation>& observations) {
+  int rows = 0;
+  for (const MapObservation& m : observations) {
+    rows += m.observation->HasRange() + m.observation->HasBearing();
+  }
+  return rows;
+}
+
 // MapResiduals' rows of `observations` at `p`, into `rows`.
 void AppendMapResiduals(const std::vector<MapObservation>& observations,
                         const Eigen::Vector3d& p,
@@ -129,8 +138,7 @@ class PoseFit {
           const Eigen::Vector3d& start)
       : observations_(FindLandmarks(observations, landmarks)),
         start_(start),
-        num_rows_(static_cast<int>(
-            MapResiduals(observations, landmarks, start).size())) {}
+        num_rows_(MapRowCount(observations_)) {}
 
   int NumResiduals() const { return num_rows_; }
 
