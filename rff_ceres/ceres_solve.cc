@@ -168,14 +168,29 @@ void SetOrdering(SlamProblem* problem, ceres::Solver::Options* options) {
   }
 }
 
+double DenseReducedWork(const TrajectoryModel& model) {
+  double parameters = 0.0;
+  for (int b = 0; b < model.num_blocks(); ++b) {
+    parameters += model.block_size(b);
+  }
+  return parameters * parameters * parameters / 6.0;
+}
+
 bool RunSolve(const SolverOptions& solver, ceres::Solver::Options ceres_options,
               SlamProblem* problem, SlamResult* result, std::string* error,
               bool keep_linearization) {
   problem->DropLinearization();
   const bool asked = IsBandedCholesky(solver.linear_solver);
+  // Auto's dense reduced system (feature weights after the landmarks'
+  // elimination) against the envelope: the envelope where its factorisation
+  // costs no more than that system's, which Ceres forms from the Jacobian
+  // at every step besides.
+  const bool dense_schur =
+      ceres_options.linear_solver_type == ceres::DENSE_SCHUR;
   if (asked ||
       (solver.linear_solver == "auto" &&
-       ceres_options.linear_solver_type == ceres::SPARSE_NORMAL_CHOLESKY &&
+       (dense_schur ||
+        ceres_options.linear_solver_type == ceres::SPARSE_NORMAL_CHOLESKY) &&
        ceres_options.trust_region_strategy_type ==
            ceres::LEVENBERG_MARQUARDT)) {
     const BandedColumns columns = problem->BandColumns();
@@ -202,7 +217,14 @@ bool RunSolve(const SolverOptions& solver, ceres::Solver::Options ceres_options,
                       "%.3g GB allowed by --max_memory_gb",
                       bytes / 1e9, limit / 1e9);
         why = text;
-      } else if (!asked && !banded->has_panels() &&
+      } else if (!asked && dense_schur &&
+                 size.multiply_adds > DenseReducedWork(problem->model())) {
+        std::snprintf(text, sizeof(text),
+                      "%.3g multiply-adds in its factorisation, more than "
+                      "the %.3g of the dense reduced system",
+                      size.multiply_adds, DenseReducedWork(problem->model()));
+        why = text;
+      } else if (!asked && !dense_schur && !banded->has_panels() &&
                  work > kMaxEnvelopeWorkPerVariable) {
         // Landmarks seen over long stretches fill their rows of the factor;
         // a fill-reducing sparse Cholesky then does better on narrow
@@ -219,8 +241,12 @@ bool RunSolve(const SolverOptions& solver, ceres::Solver::Options ceres_options,
       if (!asked) {
         result->linear_solver = kBandedCholesky;
         result->linear_solver_reason =
-            "banded states: Levenberg-Marquardt on a Cholesky of the whole "
-            "system in time order";
+            dense_schur ? "windowed weights whose envelope factorises in no "
+                          "more multiply-adds than the dense reduced system: "
+                          "Levenberg-Marquardt on a Cholesky of the whole "
+                          "system in time order"
+                        : "banded states: Levenberg-Marquardt on a Cholesky "
+                          "of the whole system in time order";
       }
       BandedLinearization last;
       MinimizeBanded(ceres_options, banded.get(), problem->problem(),

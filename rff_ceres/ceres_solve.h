@@ -53,6 +53,10 @@ struct SolverOptions {
 bool ToCeresOptions(const SolverOptions& options,
                     ceres::Solver::Options* ceres_options, std::string* error);
 
+// The multiply-adds of one Cholesky of auto's dense reduced system (the
+// model's weights after the landmarks' elimination): t^3 / 6.
+double DenseReducedWork(const TrajectoryModel& model);
+
 // "auto" settles on AutoLinearSolverType; an explicit choice is obeyed.
 // Records the choice and why in result->linear_solver(_reason).
 void ChooseLinearSolver(const SolverOptions& solver,
