@@ -226,6 +226,57 @@ TEST(SlamSolverTest, FeatureWindowsTakeTheBandedCholeskyBeyondTheWorkRule) {
   EXPECT_LT(LargestPositionDifference(banded, ceres_side), 1e-9);
 }
 
+// Auto's DENSE_SCHUR gives way to the envelope where its factorisation is
+// no dearer than the dense reduced system's t^3 / 6: few weights in many
+// windows (RFF's correction of a WNOA mean on long runs). The envelope then
+// takes Ceres's steps. One global map of the same weights beside many
+// landmarks keeps DENSE_SCHUR: the landmarks' rows fill the envelope.
+TEST(SlamSolverTest, SmallWindowedModelsTakeTheEnvelopeOverDenseSchur) {
+  SimulationOptions sim = PaperOptions(7);
+  sim.num_steps = 400;
+  sim.num_landmarks = 6;
+  Dataset dataset;
+  std::string error;
+  ASSERT_TRUE(Simulate(sim, &dataset, &error)) << error;
+  SlamOptions options = testing::SyntheticRangeBearingOptions();
+  options.features.num_position_features = 2;
+  options.features.num_heading_features = 2;
+  options.features.segment_length = 40.0;  // 14 windows of 6 weights.
+  options.features.segment_overlap = 12.0;
+  options.solver.linear_solver = "auto";
+  options.solver.decrement_tolerance = 0.0;  // Ceres's rules, as below.
+  SlamResult automatic;
+  ASSERT_TRUE(RunSlam(dataset, options, &automatic, &error)) << error;
+  EXPECT_EQ(automatic.linear_solver, "BANDED_CHOLESKY");
+  EXPECT_NE(automatic.linear_solver_reason.find("dense reduced system"),
+            std::string::npos)
+      << automatic.linear_solver_reason;
+  options.solver.linear_solver = "DENSE_SCHUR";
+  SlamResult dense;
+  ASSERT_TRUE(RunSlam(dataset, options, &dense, &error)) << error;
+  EXPECT_EQ(automatic.total_iterations, dense.total_iterations);
+  EXPECT_GT(automatic.total_iterations, 3);
+  EXPECT_NEAR(automatic.summary.final_cost, dense.summary.final_cost,
+              1e-9 * dense.summary.final_cost);
+  EXPECT_LT(LargestPositionDifference(automatic, dense), 1e-7);
+
+  sim.num_landmarks = 40;
+  ASSERT_TRUE(Simulate(sim, &dataset, &error)) << error;
+  options.features.num_position_features = 8;
+  options.features.num_heading_features = 8;
+  options.features.segment_length = 0.0;  // One map of 24 weights.
+  options.features.segment_overlap = 0.0;
+  options.solver.linear_solver = "auto";
+  ASSERT_TRUE(RunSlam(dataset, options, &automatic, &error)) << error;
+  EXPECT_EQ(automatic.linear_solver, "DENSE_SCHUR");
+  EXPECT_NE(automatic.linear_solver_reason.find(
+                "not BANDED_CHOLESKY: 1.87e+05 multiply-adds in its "
+                "factorisation, more than the 2.3e+03 of the dense reduced "
+                "system"),
+            std::string::npos)
+      << automatic.linear_solver_reason;
+}
+
 // The answer does not depend on where the origin is: the same run 1e9 m
 // away (Ceres's parameter tolerance is relative to the parameters' size,
 // which stopped such a solve two iterations in, at 0.45 m instead of 0.22).
