@@ -184,12 +184,9 @@ TEST(SlamSolverTest, BandedCholeskyMatchesCeresSparseCholesky) {
 // Ceres more to form than the fill costs the envelope. Auto takes it, and
 // it takes Ceres's steps.
 TEST(SlamSolverTest, FeatureWindowsTakeTheBandedCholeskyBeyondTheWorkRule) {
-  SimulationOptions sim = PaperOptions(5);
-  sim.num_steps = 1000;
-  sim.num_landmarks = 10;
-  Dataset dataset;
+  Dataset dataset = PaperDataset(5, 1000, 10, 4);
+  ASSERT_FALSE(dataset.ground_truth.empty());
   std::string error;
-  ASSERT_TRUE(Simulate(sim, &dataset, &error)) << error;
   dataset.odometry.clear();
   SlamOptions options = testing::SyntheticRangeBearingOptions();
   options.solver.linear_solver = "auto";
@@ -232,12 +229,9 @@ TEST(SlamSolverTest, FeatureWindowsTakeTheBandedCholeskyBeyondTheWorkRule) {
 // takes Ceres's steps. One global map of the same weights beside many
 // landmarks keeps DENSE_SCHUR: the landmarks' rows fill the envelope.
 TEST(SlamSolverTest, SmallWindowedModelsTakeTheEnvelopeOverDenseSchur) {
-  SimulationOptions sim = PaperOptions(7);
-  sim.num_steps = 400;
-  sim.num_landmarks = 6;
-  Dataset dataset;
+  Dataset dataset = PaperDataset(7, 400, 6, 4);
+  ASSERT_FALSE(dataset.ground_truth.empty());
   std::string error;
-  ASSERT_TRUE(Simulate(sim, &dataset, &error)) << error;
   SlamOptions options = testing::SyntheticRangeBearingOptions();
   options.features.num_position_features = 2;
   options.features.num_heading_features = 2;
@@ -260,8 +254,8 @@ TEST(SlamSolverTest, SmallWindowedModelsTakeTheEnvelopeOverDenseSchur) {
               1e-9 * dense.summary.final_cost);
   EXPECT_LT(LargestPositionDifference(automatic, dense), 1e-7);
 
-  sim.num_landmarks = 40;
-  ASSERT_TRUE(Simulate(sim, &dataset, &error)) << error;
+  dataset = PaperDataset(7, 400, 40, 4);
+  ASSERT_FALSE(dataset.ground_truth.empty());
   options.features.num_position_features = 8;
   options.features.num_heading_features = 8;
   options.features.segment_length = 0.0;  // One map of 24 weights.
