@@ -45,6 +45,51 @@ std::vector<double*> BandedBlockOrder(const ceres::Problem& problem,
   return order;
 }
 
+namespace {
+
+// h[j] += sum_k a[k * a_stride] b[k * b_stride + j], j < kWidth, the sum in
+// k order onto h[j] (the same roundings as row by row), h[j] in registers.
+template <int kWidth>
+void AddColumnProducts(int rows, const double* a, int a_stride,
+                       const double* b, int b_stride, double* h) {
+  double sum[kWidth];
+  for (int j = 0; j < kWidth; ++j) sum[j] = h[j];
+  for (int k = 0; k < rows; ++k) {
+    const double v = a[k * a_stride];
+    const double* bk = b + k * b_stride;
+    for (int j = 0; j < kWidth; ++j) sum[j] += v * bk[j];
+  }
+  for (int j = 0; j < kWidth; ++j) h[j] = sum[j];
+}
+
+// The same for any width: fixed widths up to a WNOA state's 6, the others
+// (feature windows' non-panel products) row by row.
+void AddColumnProducts(int width, int rows, const double* a, int a_stride,
+                       const double* b, int b_stride, double* h) {
+  switch (width) {
+    case 1:
+      return AddColumnProducts<1>(rows, a, a_stride, b, b_stride, h);
+    case 2:
+      return AddColumnProducts<2>(rows, a, a_stride, b, b_stride, h);
+    case 3:
+      return AddColumnProducts<3>(rows, a, a_stride, b, b_stride, h);
+    case 4:
+      return AddColumnProducts<4>(rows, a, a_stride, b, b_stride, h);
+    case 5:
+      return AddColumnProducts<5>(rows, a, a_stride, b, b_stride, h);
+    case 6:
+      return AddColumnProducts<6>(rows, a, a_stride, b, b_stride, h);
+    default:
+      for (int k = 0; k < rows; ++k) {
+        const double v = a[k * a_stride];
+        const double* bk = b + k * b_stride;
+        for (int j = 0; j < width; ++j) h[j] += v * bk[j];
+      }
+  }
+}
+
+}  // namespace
+
 BandedProblem::BandedProblem(const ceres::Problem& problem,
                              const BandedColumns& columns) {
   std::vector<ceres::ResidualBlockId> ids;
@@ -320,13 +365,8 @@ void BandedProblem::Accumulate(const Term& term, Eigen::VectorXd* g,
       const double* jb = jacobian_rows_[b].data();
       const int sb = term.size[b];
       for (int i = 0; i < sa; ++i) {
-        double* hi = &(*h)(ca + i, cb);
-        const int width = a == b ? i + 1 : sb;
-        for (int k = 0; k < rows; ++k) {
-          const double v = ja[k * sa + i];
-          const double* jbk = jb + k * sb;
-          for (int j = 0; j < width; ++j) hi[j] += v * jbk[j];
-        }
+        AddColumnProducts(a == b ? i + 1 : sb, rows, ja + i, sa, jb, sb,
+                          &(*h)(ca + i, cb));
       }
     }
   }
