@@ -50,8 +50,8 @@ namespace {
 // h[j] += sum_k a[k * a_stride] b[k * b_stride + j], j < kWidth, the sum in
 // k order onto h[j] (the same roundings as row by row), h[j] in registers.
 template <int kWidth>
-void AddColumnProducts(int rows, const double* a, int a_stride,
-                       const double* b, int b_stride, double* h) {
+void AddColumnProducts(int rows, const double* a, int a_stride, const double* b,
+                       int b_stride, double* h) {
   double sum[kWidth];
   for (int j = 0; j < kWidth; ++j) sum[j] = h[j];
   for (int k = 0; k < rows; ++k) {
