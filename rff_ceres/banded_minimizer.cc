@@ -250,10 +250,10 @@ void MinimizeBanded(const ceres::Solver::Options& options,
     const double solve_start = Now();
     Eigen::VectorXd step;
     double model_cost_change = 0.0;
-    bool valid = system.Factorize();
+    // L y = -S g solved as the rows of L are formed.
+    Eigen::VectorXd y = -scale.cwiseProduct(gradient);
+    bool valid = system.Factorize(&y);
     if (valid) {
-      const Eigen::VectorXd y =
-          system.SolveLower(-scale.cwiseProduct(gradient));
       const Eigen::VectorXd z = system.SolveUpper(y);
       step = scale.cwiseProduct(z);
       // The Gauss-Newton model's decrease -(g^T dx + dx^T H dx / 2) without

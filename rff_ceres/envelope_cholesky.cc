@@ -51,7 +51,8 @@ void EnvelopeMatrix::EliminateRowsAlike(int group, int first) {
 // Each L_ij needs L_i,j-1, so a row is one chain of dependent operations:
 // rows that start at the same column (a state's) are taken together, their
 // entries left of the group in one pass, then the group's own triangle.
-bool EnvelopeMatrix::Factorize() {
+bool EnvelopeMatrix::Factorize(Eigen::VectorXd* lower) {
+  CHECK(lower == nullptr || lower->size() == size());
   constexpr int kMaxRowsAtOnce = 6;
   using Eliminate = void (EnvelopeMatrix::*)(int, int);
   static constexpr Eliminate kEliminate[kMaxRowsAtOnce + 1] = {
@@ -85,6 +86,12 @@ bool EnvelopeMatrix::Factorize() {
       if (!(diagonal > 0.0) || !std::isfinite(diagonal)) return false;
       li[i - first] = std::sqrt(diagonal);
       inverse_diagonal_[i] = 1.0 / li[i - first];
+      if (lower != nullptr) {
+        double& y = (*lower)[i];
+        double sum = y;
+        for (int k = first; k < i; ++k) sum -= li[k - first] * (*lower)[k];
+        y = sum / li[i - first];
+      }
     }
   }
   return true;

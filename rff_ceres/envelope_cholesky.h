@@ -44,8 +44,10 @@ class EnvelopeMatrix {
   const double* row(int i) const { return values_.data() + start_[i]; }
 
   // Replaces the matrix by its Cholesky factor L; false (matrix left
-  // partly overwritten) when a pivot is not positive and finite.
-  bool Factorize();
+  // partly overwritten) when a pivot is not positive and finite. With
+  // `lower`, also replaces it by L^-1 lower, each row of L used as it is
+  // formed (SolveLower's arithmetic, without a pass of its own over L).
+  bool Factorize(Eigen::VectorXd* lower = nullptr);
   // A^-1 b with the factor of Factorize: L^-T (L^-1 b), each half apart.
   Eigen::VectorXd Solve(const Eigen::VectorXd& b) const;
   Eigen::VectorXd SolveLower(const Eigen::VectorXd& b) const;

@@ -179,6 +179,22 @@ TEST(EnvelopeCholeskyTest, FactorMatchesEigensWithLandmarksSeenOverStretches) {
   }
 }
 
+// The forward solve done as the factor's rows are formed gives
+// SolveLower's bits.
+TEST(EnvelopeCholeskyTest, FactorizeSolvesLowerAsSolveLower) {
+  std::vector<int> first;
+  const Eigen::MatrixXd a = BandedWithBorder(50, 3, 2, &first);
+  const Eigen::VectorXd b = Eigen::VectorXd::LinSpaced(a.rows(), -3.0, 5.0);
+  EnvelopeMatrix alone = FromDense(a, first);
+  ASSERT_TRUE(alone.Factorize());
+  const Eigen::VectorXd expected = alone.SolveLower(b);
+  EnvelopeMatrix fused = FromDense(a, first);
+  Eigen::VectorXd y = b;
+  ASSERT_TRUE(fused.Factorize(&y));
+  for (int i = 0; i < a.rows(); ++i) EXPECT_EQ(y[i], expected[i]) << i;
+  EXPECT_GT((y - b).norm(), 1.0);
+}
+
 // Many right-hand sides at once give, column by column, Solve's bits.
 TEST(EnvelopeCholeskyTest, SolveInPlaceGivesSolvesBitsPerColumn) {
   std::vector<int> first;
