@@ -1,6 +1,7 @@
 #include "rff_ceres/allocator.h"
 
 #include <cstdlib>  // Defines __GLIBC__ where it applies.
+#include <cstring>
 
 #if defined(__GLIBC__)
 #include <malloc.h>
@@ -8,6 +9,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <cstdio>
 #include <vector>
 #endif
 
@@ -16,10 +18,23 @@ namespace rff {
 #if defined(__GLIBC__)
 namespace {
 
+// The process's settings for HeapReserveIsFree.
+bool ReserveIsFreeHere() {
+  std::FILE* file = std::fopen("/proc/sys/vm/overcommit_memory", "r");
+  int mode = 0;
+  if (file != nullptr) {
+    if (std::fscanf(file, "%d", &mode) != 1) mode = 0;
+    std::fclose(file);
+  }
+  return HeapReserveIsFree(std::getenv("MALLOC_PERTURB_"),
+                           std::getenv("GLIBC_TUNABLES"), mode);
+}
+
 // Heap blocks allocated together and freed leave one free top chunk of
 // their size, which later allocations are carved from; its whole 2 MiB
 // pages are marked for huge pages.
 void ReserveHugePageHeap() {
+  if (!ReserveIsFreeHere()) return;
   constexpr std::size_t kBlockBytes = kMaxHeapBlockBytes / 2;
   std::vector<char*> blocks;
   for (std::size_t bytes = 0; bytes < kHugePageHeapBytes;
@@ -50,6 +65,18 @@ void ReserveHugePageHeap() {
 
 }  // namespace
 #endif
+
+bool HeapReserveIsFree(const char* malloc_perturb, const char* glibc_tunables,
+                       int overcommit_memory) {
+  if (malloc_perturb != nullptr && std::atoi(malloc_perturb) != 0) {
+    return false;
+  }
+  if (glibc_tunables != nullptr &&
+      std::strstr(glibc_tunables, "glibc.malloc.perturb") != nullptr) {
+    return false;
+  }
+  return overcommit_memory != 2;
+}
 
 bool RetainFreedMemory() {
 #if defined(__GLIBC__)

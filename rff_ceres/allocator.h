@@ -18,12 +18,21 @@ namespace rff {
 // Then grows the heap by kHugePageHeapBytes of address space (nothing is
 // touched, so nothing is resident) and asks the kernel for transparent huge
 // pages there (madvise; where the kernel has them off, nothing changes).
+// Only where that is free (HeapReserveIsFree).
 // A process-wide setting: for the command-line tools, called once at the
 // start of main. False where the C library has no such setting.
 constexpr int kRetainedBytes = 1 << 30;
 constexpr int kMaxHeapBlockBytes = 1 << 25;
 constexpr std::size_t kHugePageHeapBytes = std::size_t{256} << 20;
 bool RetainFreedMemory();
+
+// Whether the reserve costs nothing: not where glibc fills memory on every
+// malloc and free (MALLOC_PERTURB_ non-zero, glibc.malloc.perturb in
+// GLIBC_TUNABLES: the reserve would be written in full), nor under strict
+// overcommit (vm.overcommit_memory 2: it would hold its size of commit
+// charge). Null for an unset variable.
+bool HeapReserveIsFree(const char* malloc_perturb, const char* glibc_tunables,
+                       int overcommit_memory);
 
 }  // namespace rff
 

@@ -168,10 +168,17 @@ void SetOrdering(SlamProblem* problem, ceres::Solver::Options* options) {
   }
 }
 
-double DenseReducedWork(const TrajectoryModel& model) {
+double DenseReducedWork(SlamProblem* problem) {
+  const TrajectoryModel& model = problem->model();
+  const ceres::Problem& ceres_problem = *problem->problem();
   double parameters = 0.0;
   for (int b = 0; b < model.num_blocks(); ++b) {
-    parameters += model.block_size(b);
+    const double* block = model.block(b);
+    // As the envelope counts them: the blocks a solve can move.
+    if (ceres_problem.HasParameterBlock(block) &&
+        !ceres_problem.IsParameterBlockConstant(block)) {
+      parameters += model.block_size(b);
+    }
   }
   return parameters * parameters * parameters / 6.0;
 }
@@ -218,11 +225,11 @@ bool RunSolve(const SolverOptions& solver, ceres::Solver::Options ceres_options,
                       bytes / 1e9, limit / 1e9);
         why = text;
       } else if (!asked && dense_schur &&
-                 size.multiply_adds > DenseReducedWork(problem->model())) {
+                 size.multiply_adds > DenseReducedWork(problem)) {
         std::snprintf(text, sizeof(text),
                       "%.3g multiply-adds in its factorisation, more than "
                       "the %.3g of the dense reduced system",
-                      size.multiply_adds, DenseReducedWork(problem->model()));
+                      size.multiply_adds, DenseReducedWork(problem));
         why = text;
       } else if (!asked && !dense_schur && !banded->has_panels() &&
                  work > kMaxEnvelopeWorkPerVariable) {

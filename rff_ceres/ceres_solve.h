@@ -54,8 +54,9 @@ bool ToCeresOptions(const SolverOptions& options,
                     ceres::Solver::Options* ceres_options, std::string* error);
 
 // The multiply-adds of one Cholesky of auto's dense reduced system (the
-// model's weights after the landmarks' elimination): t^3 / 6.
-double DenseReducedWork(const TrajectoryModel& model);
+// model's weights the solve moves, after the landmarks' elimination):
+// t^3 / 6.
+double DenseReducedWork(SlamProblem* problem);
 
 // "auto" settles on AutoLinearSolverType; an explicit choice is obeyed.
 // Records the choice and why in result->linear_solver(_reason).

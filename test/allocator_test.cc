@@ -26,11 +26,14 @@ TEST(AllocatorTest, FreedLargeBuffersStayForReuse) {
   ASSERT_TRUE(RetainFreedMemory());
   constexpr std::size_t kBytes = std::size_t{16} << 20;
   const std::size_t mapped_before = mallinfo2().hblkhd;
+  std::size_t free_while_used;
   {
     std::vector<char> buffer(kBytes, 1);
     EXPECT_EQ(mallinfo2().hblkhd, mapped_before);  // Not mapped apart.
+    free_while_used = mallinfo2().fordblks;
   }
-  EXPECT_GE(mallinfo2().fordblks, kBytes);  // Kept, free, in the heap.
+  // Kept, free, in the heap.
+  EXPECT_GE(mallinfo2().fordblks, free_while_used + kBytes);
 }
 
 // Whether the kernel gives transparent huge pages where madvise asks.
@@ -72,6 +75,13 @@ TEST(AllocatorTest, TheHeapIsReservedWithHugePages) {
   GTEST_SKIP() << "AddressSanitizer replaces the allocator";
 #endif
   ASSERT_TRUE(RetainFreedMemory());
+  std::ifstream overcommit("/proc/sys/vm/overcommit_memory");
+  int mode = 0;
+  overcommit >> mode;
+  if (!HeapReserveIsFree(std::getenv("MALLOC_PERTURB_"),
+                         std::getenv("GLIBC_TUNABLES"), mode)) {
+    GTEST_SKIP() << "the reserve is not free here: nothing is reserved";
+  }
   EXPECT_GE(mallinfo2().fordblks,
             kHugePageHeapBytes - (kHugePageHeapBytes >> 3));
   if (!HugePagesOnAdvice()) {
@@ -81,7 +91,19 @@ TEST(AllocatorTest, TheHeapIsReservedWithHugePages) {
   const void* middle = buffer.data() + buffer.size() / 2;
   EXPECT_GE(AdvisedBytesAt(middle), std::int64_t{64} << 20);
 }
-#else
+#endif
+
+// glibc's perturb would write the reserve in full; strict overcommit would
+// charge it.
+TEST(AllocatorTest, TheReserveIsMadeOnlyWhereItIsFree) {
+  EXPECT_TRUE(HeapReserveIsFree(nullptr, nullptr, 0));
+  EXPECT_TRUE(HeapReserveIsFree("0", "glibc.malloc.hugetlb=1", 1));
+  EXPECT_FALSE(HeapReserveIsFree("165", nullptr, 0));
+  EXPECT_FALSE(HeapReserveIsFree(nullptr, "glibc.malloc.perturb=165", 0));
+  EXPECT_FALSE(HeapReserveIsFree(nullptr, nullptr, 2));
+}
+
+#if !defined(__GLIBC__)
 TEST(AllocatorTest, WithoutGlibcThereIsNothingToSet) {
   EXPECT_FALSE(RetainFreedMemory());
 }
