@@ -217,6 +217,8 @@ bool RunSolve(const SolverOptions& solver, ceres::Solver::Options ceres_options,
       const double bytes = 16.0 * static_cast<double>(size.entries);
       const double limit = MemoryLimitBytes(solver.max_memory_gb);
       const double work = size.multiply_adds / std::max(size.num_columns, 1);
+      const double dense_work =
+          !asked && dense_schur ? DenseReducedWork(problem) : 0.0;
       char text[160];
       if (bytes > limit) {
         std::snprintf(text, sizeof(text),
@@ -224,12 +226,11 @@ bool RunSolve(const SolverOptions& solver, ceres::Solver::Options ceres_options,
                       "%.3g GB allowed by --max_memory_gb",
                       bytes / 1e9, limit / 1e9);
         why = text;
-      } else if (!asked && dense_schur &&
-                 size.multiply_adds > DenseReducedWork(problem)) {
+      } else if (!asked && dense_schur && size.multiply_adds > dense_work) {
         std::snprintf(text, sizeof(text),
                       "%.3g multiply-adds in its factorisation, more than "
                       "the %.3g of the dense reduced system",
-                      size.multiply_adds, DenseReducedWork(problem));
+                      size.multiply_adds, dense_work);
         why = text;
       } else if (!asked && !dense_schur && !banded->has_panels() &&
                  work > kMaxEnvelopeWorkPerVariable) {
@@ -248,12 +249,13 @@ bool RunSolve(const SolverOptions& solver, ceres::Solver::Options ceres_options,
       if (!asked) {
         result->linear_solver = kBandedCholesky;
         result->linear_solver_reason =
-            dense_schur ? "windowed weights whose envelope factorises in no "
-                          "more multiply-adds than the dense reduced system: "
-                          "Levenberg-Marquardt on a Cholesky of the whole "
-                          "system in time order"
-                        : "banded states: Levenberg-Marquardt on a Cholesky "
-                          "of the whole system in time order";
+            std::string(dense_schur
+                            ? "windowed weights whose envelope factorises in "
+                              "no more multiply-adds than the dense reduced "
+                              "system"
+                            : "banded states") +
+            ": Levenberg-Marquardt on a Cholesky of the whole system in time "
+            "order";
       }
       BandedLinearization last;
       MinimizeBanded(ceres_options, banded.get(), problem->problem(),
