@@ -114,6 +114,7 @@ BandedProblem::BandedProblem(const ceres::Problem& problem,
       continue;
     }
     layout[block] = {num_columns_, size};
+    first_column_[block] = num_columns_;
     variables_.push_back(block);
     variable_sizes_.push_back(size);
     num_columns_ += size;
@@ -149,6 +150,11 @@ BandedProblem::BandedProblem(const ceres::Problem& problem,
     (variable ? terms_ : fixed_terms_).push_back(term);
   }
   envelope_first_ = EnvelopeFirst();
+}
+
+int BandedProblem::ColumnOf(const double* block) const {
+  const auto it = first_column_.find(block);
+  return it == first_column_.end() ? -1 : it->second;
 }
 
 BandedSize BandedProblem::Size() const {

@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <unordered_map>
 #include <vector>
 
 #include "Eigen/Core"
@@ -64,6 +65,9 @@ class BandedProblem {
   // Row i of H = J^T J stores from the first column any residual couples
   // to column i.
   const std::vector<int>& envelope_first() const { return envelope_first_; }
+  // The first column of a parameter block of the problem, -1 for a block
+  // that is no variable (constant, or used by no residual).
+  int ColumnOf(const double* block) const;
   BandedSize Size() const;
 
   // The variables' values as a state vector, and back.
@@ -125,6 +129,7 @@ class BandedProblem {
   void FlushPanel(EnvelopeMatrix* h);
 
   std::vector<double*> variables_;  // In column order, with their sizes.
+  std::unordered_map<const double*, int> first_column_;  // Of variables.
   std::vector<int> variable_sizes_;
   std::vector<double*> blocks_;  // Every term's blocks, columns and sizes.
   std::vector<int> columns_, sizes_;

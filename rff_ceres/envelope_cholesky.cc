@@ -107,6 +107,70 @@ double EnvelopeMatrix::FactorizationWork(const std::vector<int>& first) {
   return work;
 }
 
+std::vector<int> EnvelopeMatrix::ColumnCounts(const std::vector<int>& first) {
+  const int n = static_cast<int>(first.size());
+  // Row i lies below the diagonal in columns first(i)..i-1: +1 at its
+  // first, -1 at i, summed.
+  std::vector<int> counts(n + 1, 0);
+  for (int i = 0; i < n; ++i) {
+    ++counts[first[i]];
+    --counts[i];
+  }
+  for (int j = 1; j <= n; ++j) counts[j] += counts[j - 1];
+  counts.pop_back();
+  return counts;
+}
+
+double EnvelopeMatrix::InversionWork(const std::vector<int>& first) {
+  double work = 0.0;
+  for (const int count : ColumnCounts(first)) {
+    work += (count + 1.0) * (count + 1.0);
+  }
+  return work;
+}
+
+bool EnvelopeMatrix::InvertOnEnvelope() {
+  const int n = size();
+  // Column j's rows below the diagonal, ascending: rows_of[at[j]..at[j+1]).
+  const std::vector<int> counts = ColumnCounts(first_);
+  std::vector<std::int64_t> at(n + 1, 0);
+  for (int j = 0; j < n; ++j) at[j + 1] = at[j] + counts[j];
+  std::vector<int> rows_of(at[n]);
+  std::vector<std::int64_t> next(at.begin(), at.end() - 1);
+  for (int i = 0; i < n; ++i) {
+    for (int j = first_[i]; j < i; ++j) rows_of[next[j]++] = i;
+  }
+  std::vector<double> l, z;
+  for (int j = n - 1; j >= 0; --j) {
+    const int* rows = rows_of.data() + at[j];
+    const int m = counts[j];
+    l.resize(m);
+    z.resize(m);
+    for (int a = 0; a < m; ++a) l[a] = (*this)(rows[a], j);
+    const double d = inverse_diagonal_[j];
+    // Z_ik for k < i from row i, for k >= i from row k: both later columns.
+    for (int a = 0; a < m; ++a) {
+      const int i = rows[a];
+      const double* zi = row(i) - first_[i];
+      double sum = 0.0;
+      for (int b = 0; b < a; ++b) sum += zi[rows[b]] * l[b];
+      for (int b = a; b < m; ++b) {
+        sum += row(rows[b])[i - first_[rows[b]]] * l[b];
+      }
+      z[a] = -d * sum;
+    }
+    double sum = 0.0;
+    for (int a = 0; a < m; ++a) {
+      sum += z[a] * l[a];
+      (*this)(rows[a], j) = z[a];
+    }
+    const double zjj = d * d - d * sum;
+    if (!std::isfinite(zjj)) return false;
+    (*this)(j, j) = zjj;
+  }
+  return true;
+}
+
 Eigen::VectorXd EnvelopeMatrix::Solve(const Eigen::VectorXd& b) const {
   return SolveUpper(SolveLower(b));
 }

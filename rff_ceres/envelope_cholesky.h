@@ -60,10 +60,30 @@ class EnvelopeMatrix {
   // The multiply-adds of Factorize on an envelope that starts at `first`.
   static double FactorizationWork(const std::vector<int>& first);
 
+  // Replaces the factor of Factorize by the entries of A^-1 on the
+  // envelope, which holds every Z_ik the recurrence needs (Takahashi,
+  // Fagan and Chin 1973): for the rows i > j of column j of L, last
+  // column first,
+  //   Z_ij = -(1 / L_jj) sum_k Z_ik L_kj,
+  //   Z_jj = 1 / L_jj^2 - (1 / L_jj) sum_k Z_kj L_kj.
+  // False (values left partly overwritten) where an entry is not finite.
+  // The solves are meaningless after it.
+  bool InvertOnEnvelope();
+  // Its multiply-adds on an envelope that starts at `first`: sum over the
+  // columns of (rows below the diagonal + 1)^2.
+  static double InversionWork(const std::vector<int>& first);
+  // Entry (i, j) of the symmetric matrix from either triangle's position:
+  // (i, j) or (j, i) must lie on the envelope.
+  double Symmetric(int i, int j) const {
+    return i >= j ? (*this)(i, j) : (*this)(j, i);
+  }
+
  private:
   // Factorize's entries left of a group of rows that start alike.
   template <int kCount>
   void EliminateRowsAlike(int group, int first);
+  // Rows below the diagonal per column: how many, from `first`.
+  static std::vector<int> ColumnCounts(const std::vector<int>& first);
 
   std::vector<int> first_;
   std::vector<std::int64_t> start_;  // Row i's entries at start_[i].

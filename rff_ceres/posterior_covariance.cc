@@ -9,6 +9,8 @@
 
 #include "Eigen/Eigenvalues"
 #include "ceres/covariance.h"
+#include "rff_ceres/banded_problem.h"
+#include "rff_ceres/envelope_cholesky.h"
 #include "rff_ceres/gauss_newton_system.h"
 #include "rff_ceres/io/text_parser.h"
 #include "rff_ceres/option_error.h"
@@ -134,31 +136,25 @@ bool SchurCovariance(SlamProblem* problem, const TrajectoryModel& model,
   return true;
 }
 
-// The same blocks from the selected inverse of a sparse Cholesky of J^T J
-// (selected_inverse.h), where every block needed lies on its factor's
-// pattern. False, with nothing filled, where J^T J is not positive definite,
-// the factor is too large or a block is off its pattern.
-constexpr std::int64_t kMaxSelectedInverseNonzeros = std::int64_t{1} << 25;
-bool SelectedInverseCovariance(SlamProblem* problem,
-                               const TrajectoryModel& model,
-                               const LinearizedProblem& linearized,
-                               const std::set<std::pair<int, int>>& block_pairs,
-                               const std::vector<Landmark>& landmarks,
-                               CovarianceBlocks* blocks) {
+// The blocks from computed entries of (J^T J)^-1: `column(block)` the
+// first column of a parameter block (-1 for none), `entry(i, j, &value)`
+// false where (i, j) was not computed. False, with nothing filled, where a
+// block needed was not.
+template <typename Column, typename Entry>
+bool FillBlocks(SlamProblem* problem, const TrajectoryModel& model,
+                const std::set<std::pair<int, int>>& block_pairs,
+                const std::vector<Landmark>& landmarks, Column column,
+                Entry entry, CovarianceBlocks* blocks) {
   ceres::Problem* ceres_problem = problem->problem();
-  const std::map<const double*, int>& offset = linearized.offsets;
-  const Eigen::SparseMatrix<double> information =
-      linearized.jacobian.transpose() * linearized.jacobian;
-  SelectedInverse inverse;
-  if (!inverse.Compute(information, kMaxSelectedInverseNonzeros)) return false;
   auto fill = [&](const double* a, const double* b, Eigen::MatrixXd* block) {
     const int rows = ceres_problem->ParameterBlockSize(a);
     const int cols = ceres_problem->ParameterBlockSize(b);
+    const int first_row = column(a), first_col = column(b);
+    if (first_row < 0 || first_col < 0) return false;
     block->resize(rows, cols);
     for (int i = 0; i < rows; ++i) {
       for (int j = 0; j < cols; ++j) {
-        if (!inverse.Entry(offset.at(a) + i, offset.at(b) + j,
-                           &(*block)(i, j))) {
+        if (!entry(first_row + i, first_col + j, &(*block)(i, j))) {
           return false;
         }
       }
@@ -178,6 +174,58 @@ bool SelectedInverseCovariance(SlamProblem* problem,
   }
   *blocks = std::move(filled);
   return true;
+}
+
+// The blocks from H^-1 on the time-ordered envelope of a banded system
+// (FactorizeBanded: the solve's own H where it left one). False, with
+// nothing filled, where the envelope does not serve, H is not positive
+// definite or a block lies outside the envelope.
+bool EnvelopeCovariance(SlamProblem* problem, const TrajectoryModel& model,
+                        const std::set<std::pair<int, int>>& block_pairs,
+                        const std::vector<Landmark>& landmarks,
+                        CovarianceBlocks* blocks) {
+  BandedSystem system;
+  if (!FactorizeBanded(problem, &system) ||
+      !system.factor->InvertOnEnvelope()) {
+    return false;
+  }
+  const BandedProblem& banded = *system.banded;
+  const EnvelopeMatrix& inverse = *system.factor;
+  return FillBlocks(
+      problem, model, block_pairs, landmarks,
+      [&](const double* block) { return banded.ColumnOf(block); },
+      [&](int i, int j, double* value) {
+        if (std::min(i, j) < inverse.first(std::max(i, j))) return false;
+        *value = inverse.Symmetric(i, j);
+        return true;
+      },
+      blocks);
+}
+
+// The same blocks from the selected inverse of a sparse Cholesky of J^T J
+// (selected_inverse.h), where every block needed lies on its factor's
+// pattern. False, with nothing filled, where J^T J is not positive definite,
+// the factor is too large or a block is off its pattern.
+constexpr std::int64_t kMaxSelectedInverseNonzeros = std::int64_t{1} << 25;
+bool SelectedInverseCovariance(SlamProblem* problem,
+                               const TrajectoryModel& model,
+                               const LinearizedProblem& linearized,
+                               const std::set<std::pair<int, int>>& block_pairs,
+                               const std::vector<Landmark>& landmarks,
+                               CovarianceBlocks* blocks) {
+  const std::map<const double*, int>& offset = linearized.offsets;
+  const Eigen::SparseMatrix<double> information =
+      linearized.jacobian.transpose() * linearized.jacobian;
+  SelectedInverse inverse;
+  if (!inverse.Compute(information, kMaxSelectedInverseNonzeros)) return false;
+  return FillBlocks(
+      problem, model, block_pairs, landmarks,
+      [&](const double* block) {
+        const auto it = offset.find(block);
+        return it == offset.end() ? -1 : it->second;
+      },
+      [&](int i, int j, double* value) { return inverse.Entry(i, j, value); },
+      blocks);
 }
 
 // The same blocks from ceres::Covariance with `options.algorithm`.
@@ -267,22 +315,27 @@ bool ComputePosteriorCovariance(SlamProblem* problem,
   if (requests.empty()) return true;
 
   CovarianceBlocks blocks;
-  // One linearisation serves both exact methods.
-  LinearizedProblem linearized;
-  const bool exact = (options.use_schur || options.use_selected_inverse) &&
-                     LinearizeLandmarksLast(problem, &linearized);
-  CovarianceMethod used = CovarianceMethod::kCeres;
-  if (exact && options.use_schur &&
-      SchurCovariance(problem, model, linearized, block_pairs, *landmarks,
-                      &blocks)) {
-    used = CovarianceMethod::kSchur;
-  } else if (exact && options.use_selected_inverse &&
-             SelectedInverseCovariance(problem, model, linearized, block_pairs,
-                                       *landmarks, &blocks)) {
-    used = CovarianceMethod::kSelectedInverse;
-  } else if (!CeresCovariance(problem, model, block_pairs, requests, *landmarks,
-                              options, &blocks, error)) {
-    return false;
+  CovarianceMethod used = CovarianceMethod::kEnvelope;
+  if (!options.use_envelope ||
+      !EnvelopeCovariance(problem, model, block_pairs, *landmarks, &blocks)) {
+    // One linearisation serves both sparse exact methods.
+    LinearizedProblem linearized;
+    const bool exact = (options.use_schur || options.use_selected_inverse) &&
+                       LinearizeLandmarksLast(problem, &linearized);
+    if (exact && options.use_schur &&
+        SchurCovariance(problem, model, linearized, block_pairs, *landmarks,
+                        &blocks)) {
+      used = CovarianceMethod::kSchur;
+    } else if (exact && options.use_selected_inverse &&
+               SelectedInverseCovariance(problem, model, linearized,
+                                         block_pairs, *landmarks, &blocks)) {
+      used = CovarianceMethod::kSelectedInverse;
+    } else if (CeresCovariance(problem, model, block_pairs, requests,
+                               *landmarks, options, &blocks, error)) {
+      used = CovarianceMethod::kCeres;
+    } else {
+      return false;
+    }
   }
   if (method != nullptr) *method = used;
   const auto& sigma = blocks.trajectory;

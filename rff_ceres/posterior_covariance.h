@@ -23,6 +23,11 @@ namespace rff {
 
 // How the covariance was computed, the first that applies in this order.
 enum class CovarianceMethod {
+  // The inverse on the time-ordered envelope BANDED_CHOLESKY factorises
+  // (EnvelopeMatrix::InvertOnEnvelope: the cost of one factorisation), for
+  // banded states and for any model a BANDED_CHOLESKY solve left its H for,
+  // where the envelope holds every block needed.
+  kEnvelope,
   // The Schur form of J^T J (gauss_newton_system.h: linear in the
   // landmarks) where the trajectory has at most kMaxDenseReducedSystem
   // parameters.
@@ -35,6 +40,7 @@ enum class CovarianceMethod {
 };
 
 struct CovarianceOptions {
+  bool use_envelope = true;
   bool use_schur = true;
   bool use_selected_inverse = true;
   // SPARSE_QR (SuiteSparseQR) scales to long runs but needs a full-rank

@@ -4,6 +4,7 @@
 #include <random>
 
 #include "Eigen/Cholesky"
+#include "Eigen/LU"
 #include "gtest/gtest.h"
 
 namespace rff {
@@ -110,7 +111,7 @@ TEST(EnvelopeCholeskyTest, FactorMatchesEigensWithBlocksOfEverySize) {
 // variables, each coupled to the next, and landmarks of 2 seen from
 // overlapping stretches of states, each placed after the last state that
 // sees it: long landmark rows that cross other landmarks' columns.
-TEST(EnvelopeCholeskyTest, FactorMatchesEigensWithLandmarksSeenOverStretches) {
+Eigen::MatrixXd LandmarksSeenOverStretches(std::vector<int>* first) {
   const int num_states = 200;
   const std::vector<std::pair<int, int>> sightings = {
       {0, 150},  {5, 40},   {10, 120},  {30, 60},   {45, 199},
@@ -158,15 +159,23 @@ TEST(EnvelopeCholeskyTest, FactorMatchesEigensWithLandmarksSeenOverStretches) {
   Eigen::MatrixXd j(rows.size(), n);
   for (std::size_t r = 0; r < rows.size(); ++r) j.row(r) = rows[r];
   const Eigen::MatrixXd a = j.transpose() * j;
-  std::vector<int> first(n);
+  first->assign(n, 0);
   int long_rows = 0;
   for (int i = 0; i < n; ++i) {
     int f = 0;
     while (a(i, f) == 0.0) ++f;
-    first[i] = f;
+    (*first)[i] = f;
     if (i - f >= 64) ++long_rows;
   }
   EXPECT_GE(long_rows, 12);
+  return a;
+}
+
+// Its factor is Eigen's, entry for entry.
+TEST(EnvelopeCholeskyTest, FactorMatchesEigensWithLandmarksSeenOverStretches) {
+  std::vector<int> first;
+  const Eigen::MatrixXd a = LandmarksSeenOverStretches(&first);
+  const int n = static_cast<int>(a.rows());
   EnvelopeMatrix e = FromDense(a, first);
   ASSERT_TRUE(e.Factorize());
   const Eigen::MatrixXd l = a.llt().matrixL();
@@ -177,6 +186,35 @@ TEST(EnvelopeCholeskyTest, FactorMatchesEigensWithLandmarksSeenOverStretches) {
       ASSERT_NEAR(entry, l(i, k), tolerance) << i << ", " << k;
     }
   }
+}
+
+// The inverse on the envelope is the dense inverse there, for banded
+// states with a border and for landmarks seen over stretches.
+TEST(EnvelopeCholeskyTest, InverseOnTheEnvelopeIsTheDenseInverse) {
+  for (const bool stretches : {false, true}) {
+    std::vector<int> first;
+    const Eigen::MatrixXd a = stretches ? LandmarksSeenOverStretches(&first)
+                                        : BandedWithBorder(60, 4, 3, &first);
+    EnvelopeMatrix e = FromDense(a, first);
+    ASSERT_TRUE(e.Factorize());
+    ASSERT_TRUE(e.InvertOnEnvelope());
+    const Eigen::MatrixXd inverse = a.inverse();
+    const double tolerance = 1e-10 * inverse.norm();
+    for (int i = 0; i < e.size(); ++i) {
+      for (int k = first[i]; k <= i; ++k) {
+        ASSERT_NEAR(e(i, k), inverse(i, k), tolerance) << i << ", " << k;
+        ASSERT_EQ(e.Symmetric(k, i), e(i, k));
+      }
+    }
+  }
+}
+
+// Rows below the diagonal per column, plus one, squared: first = {0, 0, 1}
+// has one in columns 0 and 1, none in column 2.
+TEST(EnvelopeCholeskyTest, InversionWorkCountsTheColumns) {
+  EXPECT_EQ(EnvelopeMatrix::InversionWork({0, 0, 1}), 4.0 + 4.0 + 1.0);
+  EXPECT_EQ(EnvelopeMatrix::InversionWork({0, 0, 0}), 9.0 + 4.0 + 1.0);
+  EXPECT_EQ(EnvelopeMatrix::InversionWork({0, 1, 2}), 3.0);
 }
 
 // The forward solve done as the factor's rows are formed gives

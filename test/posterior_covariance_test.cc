@@ -12,6 +12,7 @@
 #include "costs/weight_prior_cost.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
+#include "rff_ceres/ceres_solve.h"
 #include "rff_ceres/feature_trajectory.h"
 #include "rff_ceres/io/text_parser.h"
 #include "rff_ceres/simulate.h"
@@ -77,6 +78,7 @@ PosePrior PriorAt(double t, double sigma_xy, double sigma_theta) {
 // inverse.
 CovarianceOptions WithAlgorithm(ceres::CovarianceAlgorithmType algorithm) {
   CovarianceOptions options;
+  options.use_envelope = false;
   options.use_schur = false;
   options.use_selected_inverse = false;
   options.algorithm = algorithm;
@@ -213,12 +215,24 @@ TEST(PosteriorCovarianceTest, MatchesTheDenseInverseWithWindowedWeights) {
   }
   SlamProblem problem(model.get(), ProblemOptions());
   ASSERT_TRUE(problem.Build(dataset, initial, &error)) << error;
+  // Solved banded, the problem keeps its H: the envelope serves it once.
+  SolverOptions solver;
+  solver.linear_solver = "BANDED_CHOLESKY";
+  solver.max_iterations = 3;
+  ceres::Solver::Options ceres_options;
+  ASSERT_TRUE(ToCeresOptions(solver, &ceres_options, &error)) << error;
+  SlamResult result;
+  ASSERT_TRUE(RunSolve(solver, ceres_options, &problem, &result, &error,
+                       /*keep_linearization=*/true))
+      << error;
   std::vector<double> times;
   for (int k = 0; k < 118; ++k) times.push_back(0.5 * k + 0.25);
-  // The Schur form (the default), the selected inverse and SuiteSparseQR.
+  // The envelope, then the Schur form (the default without a kept H), the
+  // selected inverse and SuiteSparseQR.
   CovarianceOptions selected = WithAlgorithm(ceres::SPARSE_QR);
   selected.use_selected_inverse = true;
   const std::pair<CovarianceOptions, CovarianceMethod> methods[] = {
+      {CovarianceOptions(), CovarianceMethod::kEnvelope},
       {CovarianceOptions(), CovarianceMethod::kSchur},
       {selected, CovarianceMethod::kSelectedInverse},
       {WithAlgorithm(ceres::SPARSE_QR), CovarianceMethod::kCeres}};
@@ -289,9 +303,11 @@ TEST(PosteriorCovarianceTest, MatchesTheDenseInverseWithWindowedWeights) {
   }
 }
 
-// A WNOA run is banded: too many states for the Schur form, and the
-// selected inverse gives what SuiteSparseQR gives.
-TEST(PosteriorCovarianceTest, WnoaRunUsesTheSelectedInverse) {
+// A WNOA run is banded: too many states for the Schur form. The inverse on
+// its time-ordered envelope and the selected inverse of a sparse Cholesky
+// both give what SuiteSparseQR gives, with and without a robust loss (whose
+// corrected Jacobian all three read).
+TEST(PosteriorCovarianceTest, WnoaRunUsesTheEnvelope) {
   SimulationOptions sim = PaperOptions(6);
   sim.num_steps = 400;
   sim.num_landmarks = 10;
@@ -309,35 +325,53 @@ TEST(PosteriorCovarianceTest, WnoaRunUsesTheSelectedInverse) {
   std::map<LandmarkId, Eigen::Vector2d> initial;
   std::vector<Landmark> landmarks;
   for (const Landmark& l : dataset.ground_truth_landmarks) {
-    initial[l.id] = Eigen::Vector2d(l.x, l.y);
+    initial[l.id] = Eigen::Vector2d(l.x + 0.3, l.y - 0.2);
     landmarks.push_back(l);
   }
-  SlamProblem problem(model.get(), ProblemOptions());
-  ASSERT_TRUE(problem.Build(dataset, initial, &error)) << error;
   std::vector<double> output;
   for (int k = 0; k < 200; ++k) output.push_back(1.7 * k + 0.3);
-  std::vector<Eigen::Matrix3d> selected, reference;
-  std::vector<Landmark> selected_landmarks = landmarks;
-  CovarianceMethod method = CovarianceMethod::kCeres;
-  ASSERT_TRUE(ComputePosteriorCovariance(&problem, *model, output,
-                                         CovarianceOptions(), &selected,
-                                         &selected_landmarks, &error, &method))
-      << error;
-  EXPECT_EQ(method, CovarianceMethod::kSelectedInverse);
-  ASSERT_TRUE(ComputePosteriorCovariance(
-      &problem, *model, output, WithAlgorithm(ceres::SPARSE_QR), &reference,
-      &landmarks, &error, &method))
-      << error;
-  EXPECT_EQ(method, CovarianceMethod::kCeres);
-  for (std::size_t k = 0; k < output.size(); ++k) {
-    EXPECT_LT((selected[k] - reference[k]).norm(), 1e-8 * reference[k].norm())
-        << "t = " << output[k];
-  }
-  for (std::size_t k = 0; k < landmarks.size(); ++k) {
-    EXPECT_NEAR(selected_landmarks[k].sxx, landmarks[k].sxx,
-                1e-8 * landmarks[k].sxx);
-    EXPECT_NEAR(selected_landmarks[k].sxy, landmarks[k].sxy,
-                1e-8 * landmarks[k].sxx);
+  CovarianceOptions selected_only = WithAlgorithm(ceres::SPARSE_QR);
+  selected_only.use_selected_inverse = true;
+  for (const char* loss : {"none", "cauchy"}) {
+    SCOPED_TRACE(loss);
+    ProblemOptions problem_options;
+    // At 0.5 sigma a share of the rows lies where the loss bends.
+    problem_options.loss = problem_options.odometry_loss = {loss, 0.5};
+    SlamProblem problem(model.get(), problem_options);
+    ASSERT_TRUE(problem.Build(dataset, initial, &error)) << error;
+    const std::pair<CovarianceOptions, CovarianceMethod> methods[] = {
+        {WithAlgorithm(ceres::SPARSE_QR), CovarianceMethod::kCeres},
+        {CovarianceOptions(), CovarianceMethod::kEnvelope},
+        {selected_only, CovarianceMethod::kSelectedInverse}};
+    std::vector<Eigen::Matrix3d> reference;
+    std::vector<Landmark> reference_landmarks = landmarks;
+    for (const auto& [options, expected_method] : methods) {
+      SCOPED_TRACE(static_cast<int>(expected_method));
+      std::vector<Eigen::Matrix3d> covariances;
+      std::vector<Landmark> with_covariance = landmarks;
+      CovarianceMethod method = CovarianceMethod::kCeres;
+      ASSERT_TRUE(ComputePosteriorCovariance(&problem, *model, output, options,
+                                             &covariances, &with_covariance,
+                                             &error, &method))
+          << error;
+      EXPECT_EQ(method, expected_method);
+      if (expected_method == CovarianceMethod::kCeres) {
+        reference = covariances;
+        reference_landmarks = with_covariance;
+        continue;
+      }
+      for (std::size_t k = 0; k < output.size(); ++k) {
+        EXPECT_LT((covariances[k] - reference[k]).norm(),
+                  1e-8 * reference[k].norm())
+            << "t = " << output[k];
+      }
+      for (std::size_t k = 0; k < landmarks.size(); ++k) {
+        const Landmark& expected = reference_landmarks[k];
+        EXPECT_NEAR(with_covariance[k].sxx, expected.sxx, 1e-8 * expected.sxx);
+        EXPECT_NEAR(with_covariance[k].sxy, expected.sxy, 1e-8 * expected.sxx);
+        EXPECT_NEAR(with_covariance[k].syy, expected.syy, 1e-8 * expected.syy);
+      }
+    }
   }
 }
 
