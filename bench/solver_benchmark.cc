@@ -8,6 +8,9 @@
 //   options, the "auto" linear solver against each explicit one.
 // - BM_FeatureCache/N/D/cached: building the pose maps with and without the
 //   per-time feature cache.
+// - BM_PosteriorCovariance/poses/method: every output pose's and landmark's
+//   covariance of a WNOA run, from the envelope (the default) against the
+//   selected inverse of a sparse Cholesky.
 //
 // Flags of our own (removed before Google Benchmark parses the rest):
 //   --large      also register the N = 1e6 BM_Iteration rows
@@ -39,10 +42,13 @@
 #include "rff_ceres/io/text_parser.h"
 #include "rff_ceres/landmark_init.h"
 #include "rff_ceres/mean/prior_mean.h"
+#include "rff_ceres/mean/mean_function.h"
 #include "rff_ceres/metrics.h"
+#include "rff_ceres/posterior_covariance.h"
 #include "rff_ceres/simulate.h"
 #include "rff_ceres/slam_problem.h"
 #include "rff_ceres/slam_solver.h"
+#include "rff_ceres/wnoa_trajectory.h"
 #include "test/synthetic_options.h"
 
 namespace rff {
@@ -637,6 +643,52 @@ void BM_FeatureCache(benchmark::State& state) {
   state.SetLabel(cached ? "cache shared per time" : "no sharing (distinct t)");
 }
 
+// The posterior covariance at every pose of a WNOA model on BM_DefaultSolver's
+// data (states and landmarks at the truth: the cost does not depend on the
+// point), by the envelope's inverse (method 0, the default) or the selected
+// inverse of a sparse Cholesky (method 1).
+void BM_PosteriorCovariance(benchmark::State& state) {
+  const int poses = static_cast<int>(state.range(0));
+  const int method = static_cast<int>(state.range(1));
+  const Dataset& dataset = CachedDataset(3 * poses, poses / 10, /*per_step=*/3,
+                                         /*landmark_seen_throughout=*/true);
+  std::vector<double> times;
+  for (const TimedPose& p : dataset.ground_truth) times.push_back(p.t);
+  std::string error;
+  std::unique_ptr<WnoaTrajectory> model = WnoaTrajectory::Create(
+      WnoaOptions(),
+      std::make_shared<PiecewiseLinearMean>(dataset.ground_truth), times,
+      &error);
+  std::map<LandmarkId, Eigen::Vector2d> initial;
+  std::vector<Landmark> landmarks;
+  for (const Landmark& l : dataset.ground_truth_landmarks) {
+    initial[l.id] = Eigen::Vector2d(l.x, l.y);
+    landmarks.push_back(l);
+  }
+  SlamProblem problem(model.get(), ProblemOptions());
+  if (model == nullptr || !problem.Build(dataset, initial, &error)) {
+    state.SkipWithError(error.c_str());
+    return;
+  }
+  CovarianceOptions options;
+  options.use_envelope = method == 0;
+  CovarianceMethod used = CovarianceMethod::kCeres;
+  for (auto _ : state) {
+    std::vector<Eigen::Matrix3d> covariances;
+    std::vector<Landmark> with_covariance = landmarks;
+    if (!ComputePosteriorCovariance(&problem, *model, times, options,
+                                    &covariances, &with_covariance, &error,
+                                    &used)) {
+      state.SkipWithError(error.c_str());
+      return;
+    }
+  }
+  state.SetLabel(used == CovarianceMethod::kEnvelope ? "envelope"
+                 : used == CovarianceMethod::kSelectedInverse
+                     ? "selected inverse"
+                     : "another method");
+}
+
 // Rows: {N, D, L, solver (0 dense, 1 sparse, 2 iterative), segment seconds}.
 void QuickIterationRows(benchmark::internal::Benchmark* b) {
   // N scaling at the config settings (D = 24, windows 50 s / 15 s, L = N/50).
@@ -694,6 +746,11 @@ int main(int argc, char** argv) {
   RegisterBenchmark("BM_FeatureCache", rff::BM_FeatureCache)
       ->ArgNames({"N", "D", "cached"})
       ->ArgsProduct({{10000, 100000}, {24, 100}, {1, 0}})
+      ->UseRealTime()
+      ->Unit(benchmark::kMillisecond);
+  RegisterBenchmark("BM_PosteriorCovariance", rff::BM_PosteriorCovariance)
+      ->ArgNames({"poses", "method"})
+      ->ArgsProduct({{2000, 20000}, {1, 0}})
       ->UseRealTime()
       ->Unit(benchmark::kMillisecond);
   rff::Configure(RegisterBenchmark("BM_Iteration", rff::BM_Iteration)
