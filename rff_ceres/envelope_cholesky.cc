@@ -121,14 +121,6 @@ std::vector<int> EnvelopeMatrix::ColumnCounts(const std::vector<int>& first) {
   return counts;
 }
 
-double EnvelopeMatrix::InversionWork(const std::vector<int>& first) {
-  double work = 0.0;
-  for (const int count : ColumnCounts(first)) {
-    work += (count + 1.0) * (count + 1.0);
-  }
-  return work;
-}
-
 bool EnvelopeMatrix::InvertOnEnvelope() {
   const int n = size();
   // Column j's rows below the diagonal, ascending: rows_of[at[j]..at[j+1]).

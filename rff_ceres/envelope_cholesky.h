@@ -69,9 +69,6 @@ class EnvelopeMatrix {
   // False (values left partly overwritten) where an entry is not finite.
   // The solves are meaningless after it.
   bool InvertOnEnvelope();
-  // Its multiply-adds on an envelope that starts at `first`: sum over the
-  // columns of (rows below the diagonal + 1)^2.
-  static double InversionWork(const std::vector<int>& first);
   // Entry (i, j) of the symmetric matrix from either triangle's position:
   // (i, j) or (j, i) must lie on the envelope.
   double Symmetric(int i, int j) const {

@@ -209,14 +209,6 @@ TEST(EnvelopeCholeskyTest, InverseOnTheEnvelopeIsTheDenseInverse) {
   }
 }
 
-// Rows below the diagonal per column, plus one, squared: first = {0, 0, 1}
-// has one in columns 0 and 1, none in column 2.
-TEST(EnvelopeCholeskyTest, InversionWorkCountsTheColumns) {
-  EXPECT_EQ(EnvelopeMatrix::InversionWork({0, 0, 1}), 4.0 + 4.0 + 1.0);
-  EXPECT_EQ(EnvelopeMatrix::InversionWork({0, 0, 0}), 9.0 + 4.0 + 1.0);
-  EXPECT_EQ(EnvelopeMatrix::InversionWork({0, 1, 2}), 3.0);
-}
-
 // The forward solve done as the factor's rows are formed gives
 // SolveLower's bits.
 TEST(EnvelopeCholeskyTest, FactorizeSolvesLowerAsSolveLower) {

@@ -74,8 +74,8 @@ PosePrior PriorAt(double t, double sigma_xy, double sigma_theta) {
   return p;
 }
 
-// ceres::Covariance with `algorithm`, never the Schur form or the selected
-// inverse.
+// ceres::Covariance with `algorithm`, never the envelope, the Schur form or
+// the selected inverse.
 CovarianceOptions WithAlgorithm(ceres::CovarianceAlgorithmType algorithm) {
   CovarianceOptions options;
   options.use_envelope = false;
