@@ -121,8 +121,14 @@ std::vector<int> EnvelopeMatrix::ColumnCounts(const std::vector<int>& first) {
   return counts;
 }
 
-bool EnvelopeMatrix::InvertOnEnvelope() {
+bool EnvelopeMatrix::InvertOnEnvelope(double* rcond) {
   const int n = size();
+  // A_jj = sum_k L_jk^2, from row j of the factor.
+  double largest_diagonal = 0.0;
+  for (int j = 0; j < n; ++j) {
+    const Eigen::Map<const Eigen::VectorXd> lj(row(j), j - first_[j] + 1);
+    largest_diagonal = std::max(largest_diagonal, lj.squaredNorm());
+  }
   // Column j's rows below the diagonal, ascending: rows_of[at[j]..at[j+1]).
   const std::vector<int> counts = ColumnCounts(first_);
   std::vector<std::int64_t> at(n + 1, 0);
@@ -133,6 +139,7 @@ bool EnvelopeMatrix::InvertOnEnvelope() {
     for (int j = first_[i]; j < i; ++j) rows_of[next[j]++] = i;
   }
   std::vector<double> l, z;
+  double largest_inverse_diagonal = 0.0;
   for (int j = n - 1; j >= 0; --j) {
     const int* rows = rows_of.data() + at[j];
     const int m = counts[j];
@@ -159,6 +166,10 @@ bool EnvelopeMatrix::InvertOnEnvelope() {
     const double zjj = d * d - d * sum;
     if (!std::isfinite(zjj)) return false;
     (*this)(j, j) = zjj;
+    largest_inverse_diagonal = std::max(largest_inverse_diagonal, zjj);
+  }
+  if (rcond != nullptr) {
+    *rcond = 1.0 / (largest_diagonal * largest_inverse_diagonal);
   }
   return true;
 }

@@ -67,8 +67,10 @@ class EnvelopeMatrix {
   //   Z_ij = -(1 / L_jj) sum_k Z_ik L_kj,
   //   Z_jj = 1 / L_jj^2 - (1 / L_jj) sum_k Z_kj L_kj.
   // False (values left partly overwritten) where an entry is not finite.
-  // The solves are meaningless after it.
-  bool InvertOnEnvelope();
+  // The solves are meaningless after it. With `rcond`, also a bound of
+  // A's reciprocal condition number from above, 1 / (max_j A_jj max_j
+  // (A^-1)_jj): each norm is at least its largest diagonal entry.
+  bool InvertOnEnvelope(double* rcond = nullptr);
   // Entry (i, j) of the symmetric matrix from either triangle's position:
   // (i, j) or (j, i) must lie on the envelope.
   double Symmetric(int i, int j) const {

@@ -25,8 +25,9 @@ namespace rff {
 enum class CovarianceMethod {
   // The inverse on the time-ordered envelope BANDED_CHOLESKY factorises
   // (EnvelopeMatrix::InvertOnEnvelope: the cost of one factorisation), for
-  // banded states and for any model a BANDED_CHOLESKY solve left its H for,
-  // where the envelope holds every block needed.
+  // banded states and for any model whose BANDED_CHOLESKY solve left its H
+  // (rff_slam's convergence check takes that H first), where the envelope
+  // holds every block needed and H's reciprocal condition is above 1e-14.
   kEnvelope,
   // The Schur form of J^T J (gauss_newton_system.h: linear in the
   // landmarks) where the trajectory has at most kMaxDenseReducedSystem

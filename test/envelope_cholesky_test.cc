@@ -209,6 +209,25 @@ TEST(EnvelopeCholeskyTest, InverseOnTheEnvelopeIsTheDenseInverse) {
   }
 }
 
+// The reciprocal condition bound 1 / (max A_jj max (A^-1)_jj): 1 for the
+// identity; for [1 1; 1 1 + e] (eigenvalues about 2 and e / 2) A^-1 has
+// (1 + e) / e and 1 / e on its diagonal: the bound is e / (1 + e)^2.
+TEST(EnvelopeCholeskyTest, InversionBoundsTheReciprocalCondition) {
+  EnvelopeMatrix identity({0, 1});
+  identity(0, 0) = identity(1, 1) = 1.0;
+  double rcond = 0.0;
+  ASSERT_TRUE(identity.Factorize());
+  ASSERT_TRUE(identity.InvertOnEnvelope(&rcond));
+  EXPECT_EQ(rcond, 1.0);
+  const double e = 1e-12;
+  EnvelopeMatrix nearly_singular({0, 0});
+  nearly_singular(0, 0) = nearly_singular(1, 0) = 1.0;
+  nearly_singular(1, 1) = 1.0 + e;
+  ASSERT_TRUE(nearly_singular.Factorize());
+  ASSERT_TRUE(nearly_singular.InvertOnEnvelope(&rcond));
+  EXPECT_NEAR(rcond, e / ((1.0 + e) * (1.0 + e)), 1e-3 * e);
+}
+
 // The forward solve done as the factor's rows are formed gives
 // SolveLower's bits.
 TEST(EnvelopeCholeskyTest, FactorizeSolvesLowerAsSolveLower) {
