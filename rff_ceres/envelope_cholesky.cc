@@ -150,9 +150,9 @@ bool EnvelopeMatrix::InvertOnEnvelope(double* rcond) {
     // Z_ik for k < i from row i, for k >= i from row k: both later columns.
     for (int a = 0; a < m; ++a) {
       const int i = rows[a];
-      const double* zi = row(i) - first_[i];
+      const double* zi = row(i);
       double sum = 0.0;
-      for (int b = 0; b < a; ++b) sum += zi[rows[b]] * l[b];
+      for (int b = 0; b < a; ++b) sum += zi[rows[b] - first_[i]] * l[b];
       for (int b = a; b < m; ++b) {
         sum += row(rows[b])[i - first_[rows[b]]] * l[b];
       }
