@@ -62,10 +62,12 @@ void AddColumnProducts(int rows, const double* a, int a_stride, const double* b,
   for (int j = 0; j < kWidth; ++j) h[j] = sum[j];
 }
 
-// The same for any width: fixed widths up to a WNOA state's 6, the others
-// (feature windows' non-panel products) row by row.
+// The same for any width: fixed widths up to a WNOA state's 6, wider ones
+// (feature windows' non-panel products) 6 columns at a time, each h[j]'s
+// sum the same.
 void AddColumnProducts(int width, int rows, const double* a, int a_stride,
                        const double* b, int b_stride, double* h) {
+  constexpr int kMaxWidth = 6;
   switch (width) {
     case 1:
       return AddColumnProducts<1>(rows, a, a_stride, b, b_stride, h);
@@ -80,10 +82,9 @@ void AddColumnProducts(int width, int rows, const double* a, int a_stride,
     case 6:
       return AddColumnProducts<6>(rows, a, a_stride, b, b_stride, h);
     default:
-      for (int k = 0; k < rows; ++k) {
-        const double v = a[k * a_stride];
-        const double* bk = b + k * b_stride;
-        for (int j = 0; j < width; ++j) h[j] += v * bk[j];
+      for (int j = 0; j < width; j += kMaxWidth) {
+        AddColumnProducts(std::min(kMaxWidth, width - j), rows, a, a_stride,
+                          b + j, b_stride, h + j);
       }
   }
 }
