@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "glog/logging.h"
 
@@ -121,7 +122,7 @@ std::vector<int> EnvelopeMatrix::ColumnCounts(const std::vector<int>& first) {
   return counts;
 }
 
-bool EnvelopeMatrix::InvertOnEnvelope(double* rcond) {
+bool EnvelopeMatrix::InvertOnEnvelope(double* rcond, double min_rcond) {
   const int n = size();
   // A_jj = sum_k L_jk^2, from row j of the factor.
   double largest_diagonal = 0.0;
@@ -140,6 +141,7 @@ bool EnvelopeMatrix::InvertOnEnvelope(double* rcond) {
   }
   std::vector<double> l, z;
   double largest_inverse_diagonal = 0.0;
+  double bound = std::numeric_limits<double>::infinity();
   for (int j = n - 1; j >= 0; --j) {
     const int* rows = rows_of.data() + at[j];
     const int m = counts[j];
@@ -167,11 +169,11 @@ bool EnvelopeMatrix::InvertOnEnvelope(double* rcond) {
     if (!std::isfinite(zjj)) return false;
     (*this)(j, j) = zjj;
     largest_inverse_diagonal = std::max(largest_inverse_diagonal, zjj);
+    bound = 1.0 / (largest_diagonal * largest_inverse_diagonal);
+    if (!(bound > min_rcond)) break;
   }
-  if (rcond != nullptr) {
-    *rcond = 1.0 / (largest_diagonal * largest_inverse_diagonal);
-  }
-  return true;
+  if (rcond != nullptr) *rcond = bound;
+  return bound > min_rcond;
 }
 
 Eigen::VectorXd EnvelopeMatrix::Solve(const Eigen::VectorXd& b) const {

@@ -69,8 +69,10 @@ class EnvelopeMatrix {
   // False (values left partly overwritten) where an entry is not finite.
   // The solves are meaningless after it. With `rcond`, also a bound of
   // A's reciprocal condition number from above, 1 / (max_j A_jj max_j
-  // (A^-1)_jj): each norm is at least its largest diagonal entry.
-  bool InvertOnEnvelope(double* rcond = nullptr);
+  // (A^-1)_jj): each norm is at least its largest diagonal entry. The
+  // bound only falls as columns are done: false as soon as it is at most
+  // `min_rcond` (`rcond` then the bound so far).
+  bool InvertOnEnvelope(double* rcond = nullptr, double min_rcond = 0.0);
   // Entry (i, j) of the symmetric matrix from either triangle's position:
   // (i, j) or (j, i) must lie on the envelope.
   double Symmetric(int i, int j) const {

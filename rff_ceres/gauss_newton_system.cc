@@ -48,7 +48,6 @@ Eigen::MatrixXd SolveLdltByRows(
 constexpr double kMaxDenseEntries = 33554432.0;
 constexpr int kChunkRows = 256;
 constexpr double kMaxLandmarkCondition = 1e8;
-constexpr double kMinSchurRcond = 1e-14;
 
 // Rows dense enough over the leading columns that one dense SYRK beats the
 // rows' own blocks: their nonzeros, squared and summed, above 1/4 of rows t^2
@@ -399,7 +398,7 @@ bool GaussNewtonSystem::FormSchur(const RowMajorSparse& j, int t) {
   // where its inverse is noise; a rank-revealing QR of J decides then.
   positive_definite_ = schur_.info() == Eigen::Success &&
                        schur_.vectorD().minCoeff() > 0.0 &&
-                       schur_.rcond() > kMinSchurRcond;
+                       schur_.rcond() > kMinReciprocalCondition;
   return true;
 }
 

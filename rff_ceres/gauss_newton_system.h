@@ -30,6 +30,11 @@
 
 namespace rff {
 
+// A Gauss-Newton matrix whose reciprocal condition is at most this is
+// singular to rounding: its inverse is noise, and a rank-revealing QR of J
+// decides instead (the Schur form here, the envelope's covariance).
+inline constexpr double kMinReciprocalCondition = 1e-14;
+
 using RowMajorSparse = Eigen::SparseMatrix<double, Eigen::RowMajor>;
 
 // The problem's parameter blocks with its landmarks (the ordering's group 0)

@@ -179,19 +179,17 @@ bool FillBlocks(SlamProblem* problem, const TrajectoryModel& model,
 // The blocks from H^-1 on the time-ordered envelope of a banded system
 // (FactorizeBanded: the solve's own H where it left one). False, with
 // nothing filled, where the envelope does not serve, H is not positive
-// definite or singular to rounding (as the Schur form's test: a QR of J
+// definite or singular to rounding (kMinReciprocalCondition: a QR of J
 // then decides and names the free landmarks), or a block lies outside the
 // envelope.
-constexpr double kMinEnvelopeRcond = 1e-14;
 bool EnvelopeCovariance(SlamProblem* problem, const TrajectoryModel& model,
                         const std::set<std::pair<int, int>>& block_pairs,
                         const std::vector<Landmark>& landmarks,
                         CovarianceBlocks* blocks) {
   BandedSystem system;
-  double rcond = 0.0;
   if (!FactorizeBanded(problem, &system) ||
-      !system.factor->InvertOnEnvelope(&rcond) ||
-      !(rcond > kMinEnvelopeRcond)) {
+      !system.factor->InvertOnEnvelope(/*rcond=*/nullptr,
+                                       kMinReciprocalCondition)) {
     return false;
   }
   const BandedProblem& banded = *system.banded;
