@@ -128,6 +128,11 @@ void MinimizeBanded(const ceres::Solver::Options& options,
   }
   hessian = std::make_unique<EnvelopeMatrix>(banded->envelope_first());
   EnvelopeMatrix system(banded->envelope_first());
+  // The candidate is linearised as its cost is taken (one evaluation of
+  // the residuals per step, not two); a rejected one's H is dropped.
+  auto candidate_hessian =
+      std::make_unique<EnvelopeMatrix>(banded->envelope_first());
+  Eigen::VectorXd candidate_gradient(n);
   if (!banded->Linearize(x, &cost, &gradient, hessian.get())) {
     return finish(ceres::FAILURE, "Residual and Jacobian evaluation failed.");
   }
@@ -286,7 +291,8 @@ void MinimizeBanded(const ceres::Solver::Options& options,
     next.step_is_valid = true;
     const Eigen::VectorXd candidate = x + step;
     double candidate_cost;
-    if (!banded->Cost(candidate, &candidate_cost)) {
+    if (!banded->Linearize(candidate, &candidate_cost, &candidate_gradient,
+                           candidate_hessian.get())) {
       candidate_cost = std::numeric_limits<double>::max();
     }
     next.step_norm = (x - candidate).norm();  // As Ceres: the ambient step.
@@ -312,10 +318,9 @@ void MinimizeBanded(const ceres::Solver::Options& options,
     if (next.relative_decrease > options.min_relative_decrease) {
       x = candidate;
       x_norm = x.norm();
-      if (!banded->Linearize(x, &cost, &gradient, hessian.get())) {
-        return finish(ceres::FAILURE,
-                      "Residual and Jacobian evaluation failed.");
-      }
+      cost = candidate_cost;
+      gradient.swap(candidate_gradient);
+      hessian.swap(candidate_hessian);
       next.step_is_successful = true;
       accepted_remaining =
           undamped && next.relative_decrease < 2.0

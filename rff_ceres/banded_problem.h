@@ -74,14 +74,12 @@ class BandedProblem {
   Eigen::VectorXd Gather() const;
   void Scatter(const Eigen::VectorXd& x) const;
 
-  // The cost of the terms no variable changes; false as Cost.
+  // The cost of the terms no variable changes; false as Linearize.
   bool FixedCost(double* cost);
-  // The cost at x; false where a residual is not finite or a cost
-  // function fails.
-  bool Cost(const Eigen::VectorXd& x, double* cost);
   // The cost, gradient g = J^T r and H = J^T J at x, with each robust
   // loss's correction of the residual and Jacobian (Triggs et al. 2000,
-  // 4.3, clamped as Ceres's Corrector clamps it where rho'' <= 0).
+  // 4.3, clamped as Ceres's Corrector clamps it where rho'' <= 0); false
+  // where a residual or Jacobian is not finite or a cost function fails.
   bool Linearize(const Eigen::VectorXd& x, double* cost, Eigen::VectorXd* g,
                  EnvelopeMatrix* h);
   // The residual rows of the problem, its residual blocks in order (the
@@ -90,7 +88,7 @@ class BandedProblem {
   // At x, per residual row: the residual as its loss corrects it, and the
   // row's share of tr(U^T J^T J Z), sum_p (J z_p)_row (J u_p)_row over the
   // columns of `z` and `u` (num_columns() rows each; 0 on fixed rows). One
-  // pass over the terms, no Jacobian kept. False as Cost.
+  // pass over the terms, no Jacobian kept. False as Linearize.
   bool RowProducts(const Eigen::VectorXd& x,
                    const EnvelopeMatrix::RowMajorMatrix& z,
                    const EnvelopeMatrix::RowMajorMatrix& u,

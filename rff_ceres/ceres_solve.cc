@@ -213,8 +213,9 @@ bool RunSolve(const SolverOptions& solver, ceres::Solver::Options ceres_options,
     } else {
       banded = std::make_unique<BandedProblem>(*problem->problem(), columns);
       const BandedSize size = banded->Size();
-      // The envelope twice: H and the factor of the damped system.
-      const double bytes = 16.0 * static_cast<double>(size.entries);
+      // The envelope three times: H, the candidate step's H and the
+      // factor of the damped system.
+      const double bytes = 24.0 * static_cast<double>(size.entries);
       const double limit = MemoryLimitBytes(solver.max_memory_gb);
       const double work = size.multiply_adds / std::max(size.num_columns, 1);
       const double dense_work =

@@ -9,9 +9,12 @@
 #include "ceres/problem.h"
 #include "ceres/solver.h"
 #include "costs/pose_prior_cost.h"
+#include "rff_ceres/banded_minimizer.h"
 #include "rff_ceres/dead_reckoning.h"
+#include "rff_ceres/envelope_cholesky.h"
 #include "rff_ceres/mean_rotation.h"
 #include "rff_ceres/se2.h"
+#include "rff_ceres/slam_problem.h"
 
 namespace rff {
 namespace {
@@ -22,10 +25,6 @@ constexpr int kHeadingCandidates = 72;
 // Cauchy scale of the heading score (whitened units): far-off residuals of a
 // wrong heading saturate instead of dominating.
 constexpr double kScoreLossScale = 2.0;
-// Sigmas of the pilot fit: tighter than any pilot is accurate, looser than
-// the model's feature resolution, so the fit follows the pilot's shape.
-constexpr double kFitSigmaXy = 0.05;
-constexpr double kFitSigmaTheta = 0.05;
 // Largest step of the fit's heading targets per stage (rad): well inside
 // the pi where the wrapped residual would turn the other way.
 constexpr double kMaxHeadingStage = 0.5 * M_PI;
@@ -80,7 +79,24 @@ bool FitModelToPosesOnce(const std::vector<TimedPose>& poses,
   options.max_num_iterations = 20;
   options.logging_type = ceres::SILENT;
   ceres::Solver::Summary summary;
-  ceres::Solve(options, &problem, &summary);
+  // The model's blocks in time order: a narrow envelope (feature windows,
+  // WNOA states) factorises with no symbolic analysis, as the solves do.
+  const BandedColumns columns = ModelBandColumns(model);
+  std::string why;
+  std::unique_ptr<BandedProblem> banded;
+  if (BandedSolvable(problem, columns, &why)) {
+    banded = std::make_unique<BandedProblem>(problem, columns);
+    const BandedSize size = banded->Size();
+    if (size.multiply_adds >
+        kMaxEnvelopeWorkPerVariable * std::max(size.num_columns, 1)) {
+      banded.reset();
+    }
+  }
+  if (banded) {
+    MinimizeBanded(options, banded.get(), &problem, &summary);
+  } else {
+    ceres::Solve(options, &problem, &summary);
+  }
   if (summary.termination_type == ceres::FAILURE ||
       !std::isfinite(summary.final_cost)) {
     *error = "fitting the initial trajectory failed: " + summary.message;

@@ -48,10 +48,16 @@ bool BuildPilotTrajectory(const Dataset& dataset,
                           const std::vector<double>& times,
                           std::vector<TimedPose>* pilot, std::string* why);
 
-// Sets the blocks of `model` to the MAP fit of `poses` (sigmas 0.05 m and
-// 0.05 rad) under the model's own prior: the initial value that reproduces a
-// pilot trajectory as closely as the model can. A model with a rule of its
-// own uses it (TrajectoryModel::SetBlocksFromPoses: WNOA states).
+// Sigmas of the pilot fit: tighter than any pilot is accurate, looser than
+// the model's feature resolution, so the fit follows the pilot's shape.
+inline constexpr double kFitSigmaXy = 0.05;     // m
+inline constexpr double kFitSigmaTheta = 0.05;  // rad
+
+// Sets the blocks of `model` to the MAP fit of `poses` (sigmas kFitSigmaXy
+// and kFitSigmaTheta) under the model's own prior: the initial value that
+// reproduces a pilot trajectory as closely as the model can. A model with a
+// rule of its own uses it (TrajectoryModel::SetBlocksFromPoses: WNOA
+// states); a time-ordered one is solved on its envelope (BANDED_CHOLESKY).
 bool FitModelToPoses(const std::vector<TimedPose>& poses,
                      TrajectoryModel* model, std::string* error);
 

@@ -461,12 +461,17 @@ std::shared_ptr<ceres::ParameterBlockOrdering> SlamProblem::Ordering() {
   return ordering;
 }
 
-BandedColumns SlamProblem::BandColumns() {
+BandedColumns ModelBandColumns(TrajectoryModel* model) {
   BandedColumns columns;
-  for (int b = 0; b < model_->num_blocks(); ++b) {
-    (model_->IsSharedBlock(b) ? columns.last : columns.timed)
-        .push_back(model_->mutable_block(b));
+  for (int b = 0; b < model->num_blocks(); ++b) {
+    (model->IsSharedBlock(b) ? columns.last : columns.timed)
+        .push_back(model->mutable_block(b));
   }
+  return columns;
+}
+
+BandedColumns SlamProblem::BandColumns() {
+  BandedColumns columns = ModelBandColumns(model_);
   for (double* calibration :
        {range_calibration_.data(), odometry_calibration_.data()}) {
     if (problem_->HasParameterBlock(calibration)) {

@@ -138,6 +138,10 @@ bool CheckCalibrationOptions(const ProblemOptions& options, std::string* error);
 inline constexpr int kMaxDenseReducedSystem = 2000;
 ceres::LinearSolverType AutoLinearSolverType(const TrajectoryModel& model);
 
+// The blocks of `model` as BANDED_CHOLESKY's columns: timed in time order,
+// the shared ones last.
+BandedColumns ModelBandColumns(TrajectoryModel* model);
+
 class SlamProblem {
  public:
   // `model` must outlive the problem; its blocks are the problem's.

@@ -6,8 +6,12 @@
 #include <string>
 #include <vector>
 
+#include "ceres/problem.h"
+#include "ceres/solver.h"
+#include "costs/pose_prior_cost.h"
 #include "gtest/gtest.h"
 #include "rff_ceres/feature_trajectory.h"
+#include "rff_ceres/slam_problem.h"
 #include "rff_ceres/mean/mean_function.h"
 #include "rff_ceres/se2.h"
 
@@ -47,6 +51,63 @@ TEST(FitModelToPosesTest, FollowsAHeadingThatWindsPastPi) {
   EXPECT_LT(largest_position_miss, 0.05);
   // The fitted heading is continuous: it has turned by 30 rad at the end.
   EXPECT_NEAR(model->Pose(100.0).z() - model->Pose(0.0).z(), 30.0, 0.05);
+}
+
+// Windowed weights are fitted on their envelope (BANDED_CHOLESKY): the same
+// MAP as Ceres's sparse Cholesky of the same costs, to the fit's own
+// tolerances (a thousandth of its sigmas; they stop it at about 1e-5 m).
+TEST(FitModelToPosesTest, WindowedFitIsCeresMap) {
+  std::vector<TimedPose> poses;
+  for (int k = 0; k <= 200; ++k) {
+    const double t = 0.5 * k;
+    poses.push_back({t, 3.0 * std::sin(0.05 * t) + 0.1 * t,
+                     2.0 * std::cos(0.07 * t), 0.2 * std::sin(0.03 * t)});
+  }
+  FeatureTrajectoryOptions options;
+  options.position_kernel = {"rbf", 8.0, 4.0};
+  options.heading_kernel = {"rbf", 20.0, 1.0};
+  options.num_position_features = 12;
+  options.num_heading_features = 6;
+  options.segment_length = 30.0;
+  options.segment_overlap = 10.0;
+  const auto mean =
+      std::make_shared<PiecewiseLinearMean>(std::vector<TimedPose>{poses[0]});
+  std::string error;
+  std::unique_ptr<FeatureTrajectory> fitted =
+      FeatureTrajectory::Create(options, mean, 0.0, 100.0, &error);
+  std::unique_ptr<FeatureTrajectory> reference =
+      FeatureTrajectory::Create(options, mean, 0.0, 100.0, &error);
+  ASSERT_TRUE(fitted && reference) << error;
+  ASSERT_GT(fitted->num_blocks(), 3);
+  ASSERT_TRUE(FitModelToPoses(poses, fitted.get(), &error)) << error;
+
+  ceres::Problem problem;
+  for (int b = 0; b < reference->num_blocks(); ++b) {
+    problem.AddParameterBlock(reference->mutable_block(b),
+                              reference->block_size(b));
+  }
+  reference->AddPriorCosts(&problem);
+  const Eigen::Vector3d sigma(kFitSigmaXy, kFitSigmaXy, kFitSigmaTheta);
+  for (const TimedPose& p : poses) {
+    PoseMap map = reference->PoseAt(p.t);
+    const std::vector<double*> blocks = BindPoseMaps(reference.get(), {&map});
+    problem.AddResidualBlock(
+        new PosePriorCost(std::move(map), Eigen::Vector3d(p.x, p.y, p.theta),
+                          sigma),
+        nullptr, blocks);
+  }
+  ceres::Solver::Options ceres_options;
+  ceres_options.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
+  ceres_options.function_tolerance = 1e-14;
+  ceres_options.gradient_tolerance = 1e-14;
+  ceres_options.parameter_tolerance = 1e-14;
+  ceres::Solver::Summary summary;
+  ceres::Solve(ceres_options, &problem, &summary);
+  ASSERT_TRUE(summary.IsSolutionUsable()) << summary.message;
+  for (const TimedPose& p : poses) {
+    EXPECT_NEAR((fitted->Pose(p.t) - reference->Pose(p.t)).norm(), 0.0, 5e-5)
+        << "t = " << p.t;
+  }
 }
 
 }  // namespace
