@@ -183,8 +183,11 @@ bool LearnScales(const Dataset& dataset,
     // Features follow the variance (capacity): refit them to the estimate.
     const std::vector<double> blocks = ModelBlocks(**model);
     const std::vector<TimedPose> estimate = result->trajectory;
-    *model = CreateTrajectoryModel(dataset, *settled, mean, error);
-    if (!*model) return false;
+    std::unique_ptr<TrajectoryModel> rescaled =
+        CreateTrajectoryModel(dataset, *settled, mean, error);
+    if (!rescaled) return false;
+    rescaled->AdoptCaches(**model);
+    *model = std::move(rescaled);
     if (!prior.has_features()) {
       SetModelBlocks(blocks, model->get());
     } else if (!FitModelToPoses(estimate, model->get(), error)) {

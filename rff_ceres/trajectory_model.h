@@ -71,8 +71,14 @@ class TrajectoryModel {
   }
 
   // Heading and position at t with the current block values (heading not
-  // wrapped: the model's heading is a continuous function of time).
-  Eigen::Vector3d Pose(double t) const;
+  // wrapped: the model's heading is a continuous function of time): the
+  // PoseMap's value, which a model may give without forming the map.
+  virtual Eigen::Vector3d Pose(double t) const;
+
+  // Takes what `previous`, a model of the same structure whose scales the
+  // learning changed, computed that does not depend on the scales (WNOA:
+  // the interpolation at each time). Nothing by default.
+  virtual void AdoptCaches(const TrajectoryModel& /*previous*/) {}
 };
 
 // Every block's values in block order, and back (same model structure).

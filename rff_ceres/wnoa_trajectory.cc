@@ -172,8 +172,8 @@ void WnoaTrajectory::InterpolationMatrices(double elapsed, double dt,
 
 const WnoaTrajectory::Interpolation& WnoaTrajectory::InterpolationAt(
     double t) const {
-  auto it = cache_.find(t);
-  if (it != cache_.end()) return it->second;
+  auto it = cache_->find(t);
+  if (it != cache_->end()) return it->second;
   Interpolation interpolation;
   // Only differences of nearby times enter the coefficients, computed from
   // the raw times: as precise as shifting to t_0 first, and exact at t_i.
@@ -202,7 +202,24 @@ const WnoaTrajectory::Interpolation& WnoaTrajectory::InterpolationAt(
       interpolation.phi[1][c] = RowPhi(c, psi(0, 0), psi(0, 1));
     }
   }
-  return cache_.emplace(t, std::move(interpolation)).first->second;
+  return cache_->emplace(t, std::move(interpolation)).first->second;
+}
+
+Eigen::Vector3d WnoaTrajectory::Pose(double t) const {
+  // TrajectoryModel::Pose's sums over PoseAt's terms, in their order.
+  Eigen::Vector3d pose = mean_->Evaluate(t);
+  const Interpolation& interpolation = InterpolationAt(t);
+  for (int k = 0; k < interpolation.num_blocks; ++k) {
+    const Eigen::Map<const Eigen::VectorXd> state(
+        block(interpolation.blocks[k]), kStateSize);
+    for (int c = 0; c < 3; ++c) pose[c] += interpolation.phi[k][c]->dot(state);
+  }
+  return pose;
+}
+
+void WnoaTrajectory::AdoptCaches(const TrajectoryModel& previous) {
+  const auto* wnoa = dynamic_cast<const WnoaTrajectory*>(&previous);
+  if (wnoa != nullptr && wnoa->times_ == times_) cache_ = wnoa->cache_;
 }
 
 PoseMap WnoaTrajectory::PoseAt(double t) const {

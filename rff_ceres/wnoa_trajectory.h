@@ -70,6 +70,10 @@ class WnoaTrajectory : public TrajectoryModel {
   int block_size(int /*block*/) const override { return kStateSize; }
   double* mutable_block(int block) override;
   PoseMap PoseAt(double t) const override;
+  Eigen::Vector3d Pose(double t) const override;
+  // The interpolations of `previous` where its state times are these (Q_c
+  // cancels out of them).
+  void AdoptCaches(const TrajectoryModel& previous) override;
   // The initial-state prior on block 0 and one WnoaPriorCost between every
   // pair of consecutive states (a pair belongs to its later state).
   using TrajectoryModel::AddPriorCosts;
@@ -119,8 +123,10 @@ class WnoaTrajectory : public TrajectoryModel {
   std::vector<double> states_;  // kStateSize values per state, contiguous.
   // e_c, shared by the poses at every state time.
   std::array<std::shared_ptr<const Eigen::VectorXd>, 3> unit_phi_;
-  // Observations at the same time share their phi vectors.
-  mutable std::map<double, Interpolation> cache_;
+  // Observations at the same time share their phi vectors; so do the
+  // models of a learning's rounds (AdoptCaches).
+  std::shared_ptr<std::map<double, Interpolation>> cache_ =
+      std::make_shared<std::map<double, Interpolation>>();
 };
 
 }  // namespace rff

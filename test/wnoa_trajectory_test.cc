@@ -179,6 +179,43 @@ TEST(WnoaTrajectoryTest, PhiVectorsAreSharedBetweenPosesAtOneTime) {
   }
 }
 
+// A model of the next learning round (other Q_c) reads the interpolations
+// its predecessor computed when the state times agree, and only then.
+TEST(WnoaTrajectoryTest, AdoptsTheInterpolationsOfTheSameStateTimes) {
+  WnoaOptions rescaled;
+  rescaled.position_qc = 0.3;
+  auto model = MakeTrajectory({0.0, 1.0, 2.0});
+  auto same = MakeTrajectory({0.0, 1.0, 2.0}, rescaled);
+  auto other = MakeTrajectory({0.0, 1.5, 2.0}, rescaled);
+  ASSERT_TRUE(model && same && other);
+  const PoseMap before = model->PoseAt(0.4);
+  same->AdoptCaches(*model);
+  other->AdoptCaches(*model);
+  const PoseMap after = same->PoseAt(0.4), elsewhere = other->PoseAt(0.4);
+  for (size_t k = 0; k < before.terms.size(); ++k) {
+    EXPECT_EQ(before.terms[k].phi.get(), after.terms[k].phi.get());
+    EXPECT_NE(before.terms[k].phi.get(), elsewhere.terms[k].phi.get());
+  }
+}
+
+// Pose() without the PoseMap is the map's value to the bit.
+TEST(WnoaTrajectoryTest, PoseIsThePoseMapsValue) {
+  auto model = MakeTrajectory({0.0, 1.0, 2.5, 4.0});
+  ASSERT_NE(model, nullptr);
+  std::mt19937 engine(3);
+  std::normal_distribution<double> normal;
+  for (int b = 0; b < model->num_blocks(); ++b) {
+    for (int i = 0; i < WnoaTrajectory::kStateSize; ++i) {
+      model->mutable_block(b)[i] = normal(engine);
+    }
+  }
+  for (const double t : {-1.0, 0.0, 0.3, 1.0, 2.2, 3.9, 4.0, 6.0}) {
+    const Eigen::Vector3d direct = model->Pose(t);
+    const Eigen::Vector3d mapped = model->TrajectoryModel::Pose(t);
+    EXPECT_EQ(direct, mapped) << "t = " << t;
+  }
+}
+
 // For states that follow an exact constant-velocity motion the GP mean is
 // that motion, between the states and (extrapolated) beyond them, also at
 // Unix-epoch times.
