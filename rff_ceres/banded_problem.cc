@@ -96,6 +96,8 @@ BandedProblem::BandedProblem(const ceres::Problem& problem,
   std::vector<ceres::ResidualBlockId> ids;
   problem.GetResidualBlocks(&ids);
   std::vector<int> begin;
+  begin.reserve(ids.size() + 1);
+  blocks_.reserve(2 * ids.size());
   std::vector<double*> blocks;
   for (const ceres::ResidualBlockId id : ids) {
     problem.GetParameterBlocksForResidualBlock(id, &blocks);
@@ -122,6 +124,9 @@ BandedProblem::BandedProblem(const ceres::Problem& problem,
   }
   const std::unordered_set<const double*> timed(columns.timed.begin(),
                                                 columns.timed.end());
+  columns_.reserve(blocks_.size());
+  sizes_.reserve(blocks_.size());
+  in_panel_.reserve(blocks_.size());
   for (double* block : blocks_) {
     const std::pair<int, int>& place = layout.at(block);
     columns_.push_back(place.first);
@@ -129,6 +134,7 @@ BandedProblem::BandedProblem(const ceres::Problem& problem,
     in_panel_.push_back(place.first >= 0 && place.second >= kMinPanelWidth &&
                         timed.count(block) > 0);
   }
+  terms_.reserve(ids.size());
   for (std::size_t r = 0; r < ids.size(); ++r) {
     Term term;
     term.cost = problem.GetCostFunctionForResidualBlock(ids[r]);
