@@ -396,6 +396,20 @@ PoseMap FeatureTrajectory::PoseAt(double t) const {
   return map;
 }
 
+Eigen::Vector3d FeatureTrajectory::Pose(double t) const {
+  // TrajectoryModel::Pose's sums over PoseAt's terms, in their order.
+  Eigen::Vector3d pose = mean_->Evaluate(t);
+  auto weights = [&](int b, const Eigen::VectorXd& phi) {
+    return Eigen::Map<const Eigen::VectorXd>(block(b), phi.size());
+  };
+  for (const Features& f : FeaturesAt(t)) {
+    pose[0] += f.position->dot(weights(3 * f.segment + kX, *f.position));
+    pose[1] += f.position->dot(weights(3 * f.segment + kY, *f.position));
+    pose[2] += f.heading->dot(weights(3 * f.segment + kTheta, *f.heading));
+  }
+  return pose;
+}
+
 std::vector<TrajectoryModel::PriorScale> FeatureTrajectory::PriorRowScales(
     const std::vector<double*>& blocks, int num_rows) const {
   const int offset = static_cast<int>(blocks.front() - weights_.data());

@@ -119,6 +119,7 @@ class FeatureTrajectory : public TrajectoryModel {
   int num_stretches() const { return static_cast<int>(stretches_.size()); }
   bool HasDenseReducedSystem() const override { return true; }
   PoseMap PoseAt(double t) const override;
+  Eigen::Vector3d Pose(double t) const override;
   using TrajectoryModel::AddPriorCosts;
   void AddPriorCosts(ceres::Problem* problem, int begin, int end) override;
 

@@ -97,6 +97,32 @@ TEST(FeatureTrajectoryTest, SegmentsBlendContinuously) {
   }
 }
 
+// Pose() without the PoseMap is the map's value to the bit, in blends and
+// single segments, with a mean that is not zero.
+TEST(FeatureTrajectoryTest, PoseIsThePoseMapsValue) {
+  FeatureTrajectoryOptions options =
+      Options({"rbf", 4.0, 3.0}, {"rbf", 0.3, 3.0}, 12);
+  options.segment_length = 20.0;
+  options.segment_overlap = 8.0;
+  std::string error;
+  auto model = FeatureTrajectory::Create(
+      options,
+      std::make_shared<PiecewiseLinearMean>(std::vector<TimedPose>{
+          {0.0, 1.0, -2.0, 0.3}, {100.0, 7.0, 4.0, -1.0}}),
+      0.0, 100.0, &error);
+  ASSERT_TRUE(model) << error;
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> normal;
+  for (int b = 0; b < model->num_blocks(); ++b) {
+    for (int i = 0; i < model->block_size(b); ++i) {
+      model->mutable_block(b)[i] = normal(rng);
+    }
+  }
+  for (double t = -3.0; t < 104.0; t += 0.7) {
+    EXPECT_EQ(model->Pose(t), model->TrajectoryModel::Pose(t)) << "t = " << t;
+  }
+}
+
 // Capacity follows the lengthscale: segments of 10 lengthscales, each with
 // about the same number of features (the same number of lengthscales to
 // cover at the same tolerance), whatever the lengthscale in seconds.
