@@ -18,6 +18,17 @@ std::shared_ptr<const MeanFunction> ZeroMean() {
       std::vector<TimedPose>{{0.0, 0.0, 0.0, 0.0}});
 }
 
+// Every weight drawn from N(0, 1), block by block.
+void RandomizeWeights(FeatureTrajectory* model, unsigned seed) {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> normal;
+  for (int b = 0; b < model->num_blocks(); ++b) {
+    for (int i = 0; i < model->block_size(b); ++i) {
+      model->mutable_block(b)[i] = normal(rng);
+    }
+  }
+}
+
 // Options with the given kernels (x and y, theta) and feature counts.
 FeatureTrajectoryOptions Options(const KernelOptions& position,
                                  const KernelOptions& heading, int features) {
@@ -26,6 +37,16 @@ FeatureTrajectoryOptions Options(const KernelOptions& position,
   options.heading_kernel = heading;
   options.num_position_features = features;
   options.num_heading_features = features;
+  return options;
+}
+
+// Windows of 20 s blended over 8 s, `features` per window, RBF kernels of
+// 4 s (x, y) and 0.3 s (theta).
+FeatureTrajectoryOptions WindowedOptions(int features) {
+  FeatureTrajectoryOptions options =
+      Options({"rbf", 4.0, 3.0}, {"rbf", 0.3, 3.0}, features);
+  options.segment_length = 20.0;
+  options.segment_overlap = 8.0;
   return options;
 }
 
@@ -74,22 +95,12 @@ TEST(FeatureTrajectoryTest, PriorCovarianceIsTheKernel) {
 // Windowed weights: the pose is continuous across the blends of segments
 // (random weights, the derivative bounded by the features' bandwidth).
 TEST(FeatureTrajectoryTest, SegmentsBlendContinuously) {
-  FeatureTrajectoryOptions options =
-      Options({"rbf", 4.0, 3.0}, {"rbf", 0.3, 3.0}, 40);
-  options.segment_length = 20.0;
-  options.segment_overlap = 8.0;
   std::string error;
-  auto model =
-      FeatureTrajectory::Create(options, ZeroMean(), 0.0, 100.0, &error);
+  auto model = FeatureTrajectory::Create(WindowedOptions(40), ZeroMean(), 0.0,
+                                         100.0, &error);
   ASSERT_TRUE(model) << error;
   EXPECT_EQ(model->num_segments(), 5);
-  std::mt19937_64 rng(3);
-  std::normal_distribution<double> normal;
-  for (int b = 0; b < model->num_blocks(); ++b) {
-    for (int i = 0; i < model->block_size(b); ++i) {
-      model->mutable_block(b)[i] = normal(rng);
-    }
-  }
+  RandomizeWeights(model.get(), 3);
   const double step = 1e-4;
   for (double t = 0.5; t < 99.5; t += 0.25) {
     const Eigen::Vector3d jump = model->Pose(t + step) - model->Pose(t);
@@ -100,24 +111,14 @@ TEST(FeatureTrajectoryTest, SegmentsBlendContinuously) {
 // Pose() without the PoseMap is the map's value to the bit, in blends and
 // single segments, with a mean that is not zero.
 TEST(FeatureTrajectoryTest, PoseIsThePoseMapsValue) {
-  FeatureTrajectoryOptions options =
-      Options({"rbf", 4.0, 3.0}, {"rbf", 0.3, 3.0}, 12);
-  options.segment_length = 20.0;
-  options.segment_overlap = 8.0;
   std::string error;
   auto model = FeatureTrajectory::Create(
-      options,
+      WindowedOptions(12),
       std::make_shared<PiecewiseLinearMean>(std::vector<TimedPose>{
           {0.0, 1.0, -2.0, 0.3}, {100.0, 7.0, 4.0, -1.0}}),
       0.0, 100.0, &error);
   ASSERT_TRUE(model) << error;
-  std::mt19937_64 rng(5);
-  std::normal_distribution<double> normal;
-  for (int b = 0; b < model->num_blocks(); ++b) {
-    for (int i = 0; i < model->block_size(b); ++i) {
-      model->mutable_block(b)[i] = normal(rng);
-    }
-  }
+  RandomizeWeights(model.get(), 5);
   for (double t = -3.0; t < 104.0; t += 0.7) {
     EXPECT_EQ(model->Pose(t), model->TrajectoryModel::Pose(t)) << "t = " << t;
   }

@@ -43,6 +43,17 @@ std::unique_ptr<WnoaTrajectory> MakeTrajectory(
   return model;
 }
 
+// Every state drawn from N(0, 1), block by block.
+void RandomizeStates(WnoaTrajectory* model, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> normal;
+  for (int b = 0; b < model->num_blocks(); ++b) {
+    for (int k = 0; k < WnoaTrajectory::kStateSize; ++k) {
+      model->mutable_block(b)[k] = normal(rng);
+    }
+  }
+}
+
 Eigen::Matrix2d Transition(double dt) {
   Eigen::Matrix2d phi;
   phi << 1.0, dt, 0.0, 1.0;
@@ -140,11 +151,7 @@ TEST(WnoaTrajectoryTest, ReproducesStatesAtStateTimes) {
   const std::vector<double> times = {10.0, 10.5, 12.0, 20.0};
   auto model = MakeTrajectory(times);
   ASSERT_NE(model, nullptr);
-  std::mt19937 rng(1);
-  std::normal_distribution<double> normal;
-  for (int b = 0; b < model->num_blocks(); ++b) {
-    for (int k = 0; k < 6; ++k) model->mutable_block(b)[k] = normal(rng);
-  }
+  RandomizeStates(model.get(), 1);
   const LinearMean mean(10.0);
   for (int b = 0; b < model->num_blocks(); ++b) {
     const PoseMap map = model->PoseAt(times[b]);
@@ -202,13 +209,7 @@ TEST(WnoaTrajectoryTest, AdoptsTheInterpolationsOfTheSameStateTimes) {
 TEST(WnoaTrajectoryTest, PoseIsThePoseMapsValue) {
   auto model = MakeTrajectory({0.0, 1.0, 2.5, 4.0});
   ASSERT_NE(model, nullptr);
-  std::mt19937 engine(3);
-  std::normal_distribution<double> normal;
-  for (int b = 0; b < model->num_blocks(); ++b) {
-    for (int i = 0; i < WnoaTrajectory::kStateSize; ++i) {
-      model->mutable_block(b)[i] = normal(engine);
-    }
-  }
+  RandomizeStates(model.get(), 3);
   for (const double t : {-1.0, 0.0, 0.3, 1.0, 2.2, 3.9, 4.0, 6.0}) {
     const Eigen::Vector3d direct = model->Pose(t);
     const Eigen::Vector3d mapped = model->TrajectoryModel::Pose(t);
@@ -322,11 +323,7 @@ TEST(WnoaTrajectoryTest, PoseMapUsesPositionRowOfInterpolation) {
 TEST(WnoaTrajectoryTest, PoseDerivativeMatchesNumericDifferentiation) {
   auto model = MakeTrajectory({0.0, 0.8, 1.0, 3.5});
   ASSERT_NE(model, nullptr);
-  std::mt19937 rng(4);
-  std::normal_distribution<double> normal;
-  for (int b = 0; b < model->num_blocks(); ++b) {
-    for (int k = 0; k < 6; ++k) model->mutable_block(b)[k] = normal(rng);
-  }
+  RandomizeStates(model.get(), 4);
   const double h = 1e-6;
   for (const double t : {-0.5, 0.0, 0.3, 0.8, 0.95, 2.0, 3.5, 4.2}) {
     const PoseMap map = model->PoseAt(t);
