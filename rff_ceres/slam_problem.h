@@ -11,6 +11,7 @@
 #include <set>
 #include <string>
 #include <string_view>
+#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -274,7 +275,8 @@ class SlamProblem {
 
   TrajectoryModel* model_;
   ProblemOptions options_;
-  std::map<ceres::ResidualBlockId, Source> sources_;
+  // Looked up only, once per residual block in each pass over them.
+  std::unordered_map<ceres::ResidualBlockId, Source> sources_;
   // Ceres's own lookup scans every residual (without fast removal).
   std::map<LandmarkId, std::vector<ceres::ResidualBlockId>> landmark_residuals_;
   std::unique_ptr<ceres::LossFunction> loss_;

@@ -97,8 +97,16 @@ bool BandedTraces(SlamProblem* problem, const std::vector<double*>& ll_columns,
   BandedProblem& banded = *system.banded;
   const EnvelopeMatrix& hessian = *system.factor;
   const Eigen::VectorXd& x = system.x;
-  const std::vector<int> position = TimeOrderPositions(problem, ll_columns);
   const int n = banded.num_columns();
+  // Each column's place in the envelope's time order.
+  std::vector<int> position;
+  position.reserve(n);
+  for (double* block : ll_columns) {
+    const int first = banded.ColumnOf(block);
+    if (first < 0) return false;  // A constant block.
+    const int size = problem->problem()->ParameterBlockSize(block);
+    for (int i = 0; i < size; ++i) position.push_back(first + i);
+  }
   if (static_cast<int>(position.size()) != n ||
       banded.num_rows() != static_cast<int>(groups.size())) {
     return false;
