@@ -26,6 +26,11 @@ double Now() {
 // z^T D z of the model decrease's y^T y is below kMaxDampingShare.
 constexpr double kUndampedRadius = 1e8;
 constexpr double kMaxDampingShare = 1e-2;
+// A step the function tolerance ends (|cost change| <= tol * cost) has a
+// model decrease of at most tol * cost over its gain ratio: within this
+// factor of tol * cost for any ratio above its inverse. Such a step's cost
+// is taken without the Jacobians, which a last step does not use.
+constexpr double kLastStepModelRatio = 2.0;
 
 std::string MessageWith(const char* format, double a, double b) {
   char text[160];
@@ -130,6 +135,7 @@ void MinimizeBanded(const ceres::Solver::Options& options,
   EnvelopeMatrix system(banded->envelope_first());
   // The candidate is linearised as its cost is taken (one evaluation of
   // the residuals per step, not two); a rejected one's H is dropped.
+  // Ceres's order of the tests is kept: the step's length before its cost.
   auto candidate_hessian =
       std::make_unique<EnvelopeMatrix>(banded->envelope_first());
   Eigen::VectorXd candidate_gradient(n);
@@ -290,11 +296,6 @@ void MinimizeBanded(const ceres::Solver::Options& options,
     invalid_steps = 0;
     next.step_is_valid = true;
     const Eigen::VectorXd candidate = x + step;
-    double candidate_cost;
-    if (!banded->Linearize(candidate, &candidate_cost, &candidate_gradient,
-                           candidate_hessian.get())) {
-      candidate_cost = std::numeric_limits<double>::max();
-    }
     next.step_norm = (x - candidate).norm();  // As Ceres: the ambient step.
     if (next.step_norm <=
         options.parameter_tolerance * (x_norm + options.parameter_tolerance)) {
@@ -304,6 +305,18 @@ void MinimizeBanded(const ceres::Solver::Options& options,
                       "%e <= %e.",
                       next.step_norm / (x_norm + options.parameter_tolerance),
                       options.parameter_tolerance));
+    }
+    // A step that may be the last takes its cost alone (as Ceres does);
+    // any other is linearised as its cost is taken.
+    const bool maybe_last =
+        model_cost_change <=
+        kLastStepModelRatio * options.function_tolerance * cost;
+    double candidate_cost;
+    if (!(maybe_last ? banded->Cost(candidate, &candidate_cost)
+                     : banded->Linearize(candidate, &candidate_cost,
+                                         &candidate_gradient,
+                                         candidate_hessian.get()))) {
+      candidate_cost = std::numeric_limits<double>::max();
     }
     next.cost_change = cost - candidate_cost;
     if (std::abs(next.cost_change) <= options.function_tolerance * cost) {
@@ -318,9 +331,16 @@ void MinimizeBanded(const ceres::Solver::Options& options,
     if (next.relative_decrease > options.min_relative_decrease) {
       x = candidate;
       x_norm = x.norm();
-      cost = candidate_cost;
-      gradient.swap(candidate_gradient);
-      hessian.swap(candidate_hessian);
+      if (maybe_last) {
+        if (!banded->Linearize(x, &cost, &gradient, hessian.get())) {
+          return finish(ceres::FAILURE,
+                        "Residual and Jacobian evaluation failed.");
+        }
+      } else {
+        cost = candidate_cost;
+        gradient.swap(candidate_gradient);
+        hessian.swap(candidate_hessian);
+      }
       next.step_is_successful = true;
       accepted_remaining =
           undamped && next.relative_decrease < 2.0

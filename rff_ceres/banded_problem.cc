@@ -218,6 +218,16 @@ bool BandedProblem::FixedCost(double* cost) {
   return true;
 }
 
+bool BandedProblem::Cost(const Eigen::VectorXd& x, double* cost) {
+  *cost = 0.0;
+  for (const Term& term : terms_) {
+    double term_cost;
+    if (!Evaluate(term, x, /*jacobians=*/false, &term_cost)) return false;
+    *cost += term_cost;
+  }
+  return true;
+}
+
 bool BandedProblem::Linearize(const Eigen::VectorXd& x, double* cost,
                               Eigen::VectorXd* g, EnvelopeMatrix* h) {
   *cost = 0.0;

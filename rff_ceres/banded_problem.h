@@ -76,6 +76,8 @@ class BandedProblem {
 
   // The cost of the terms no variable changes; false as Linearize.
   bool FixedCost(double* cost);
+  // The cost at x, the same sum as Linearize's; false as Linearize.
+  bool Cost(const Eigen::VectorXd& x, double* cost);
   // The cost, gradient g = J^T r and H = J^T J at x, with each robust
   // loss's correction of the residual and Jacobian (Triggs et al. 2000,
   // 4.3, clamped as Ceres's Corrector clamps it where rho'' <= 0); false
