@@ -25,6 +25,10 @@ constexpr int kHeadingCandidates = 72;
 // Cauchy scale of the heading score (whitened units): far-off residuals of a
 // wrong heading saturate instead of dominating.
 constexpr double kScoreLossScale = 2.0;
+// Sigmas of the pilot fit: tighter than any pilot is accurate, looser than
+// the model's feature resolution, so the fit follows the pilot's shape.
+constexpr double kFitSigmaXy = 0.05;
+constexpr double kFitSigmaTheta = 0.05;
 // Largest step of the fit's heading targets per stage (rad): well inside
 // the pi where the wrapped residual would turn the other way.
 constexpr double kMaxHeadingStage = 0.5 * M_PI;
@@ -61,19 +65,7 @@ double HeadingCost(const std::vector<ScoredTime>& times,
 bool FitModelToPosesOnce(const std::vector<TimedPose>& poses,
                          TrajectoryModel* model, std::string* error) {
   ceres::Problem problem;
-  for (int b = 0; b < model->num_blocks(); ++b) {
-    problem.AddParameterBlock(model->mutable_block(b), model->block_size(b));
-  }
-  model->AddPriorCosts(&problem);
-  const Eigen::Vector3d sigma(kFitSigmaXy, kFitSigmaXy, kFitSigmaTheta);
-  for (const TimedPose& p : poses) {
-    PoseMap map = model->PoseAt(p.t);
-    const std::vector<double*> blocks = BindPoseMaps(model, {&map});
-    problem.AddResidualBlock(
-        new PosePriorCost(std::move(map), Eigen::Vector3d(p.x, p.y, p.theta),
-                          sigma),
-        nullptr, blocks);
-  }
+  AddPoseFitCosts(poses, model, &problem);
   ceres::Solver::Options options;
   options.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
   options.max_num_iterations = 20;
@@ -106,6 +98,23 @@ bool FitModelToPosesOnce(const std::vector<TimedPose>& poses,
 }
 
 }  // namespace
+
+void AddPoseFitCosts(const std::vector<TimedPose>& poses,
+                     TrajectoryModel* model, ceres::Problem* problem) {
+  for (int b = 0; b < model->num_blocks(); ++b) {
+    problem->AddParameterBlock(model->mutable_block(b), model->block_size(b));
+  }
+  model->AddPriorCosts(problem);
+  const Eigen::Vector3d sigma(kFitSigmaXy, kFitSigmaXy, kFitSigmaTheta);
+  for (const TimedPose& p : poses) {
+    PoseMap map = model->PoseAt(p.t);
+    const std::vector<double*> blocks = BindPoseMaps(model, {&map});
+    problem->AddResidualBlock(
+        new PosePriorCost(std::move(map), Eigen::Vector3d(p.x, p.y, p.theta),
+                          sigma),
+        nullptr, blocks);
+  }
+}
 
 Dataset ResolveStartHeading(const Dataset& dataset, StartHeading* report) {
   *report = StartHeading();

@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "ceres/problem.h"
 #include "rff_ceres/mean/localization_mean.h"
 #include "rff_ceres/trajectory_model.h"
 #include "rff_ceres/types.h"
@@ -48,18 +49,17 @@ bool BuildPilotTrajectory(const Dataset& dataset,
                           const std::vector<double>& times,
                           std::vector<TimedPose>* pilot, std::string* why);
 
-// Sigmas of the pilot fit: tighter than any pilot is accurate, looser than
-// the model's feature resolution, so the fit follows the pilot's shape.
-inline constexpr double kFitSigmaXy = 0.05;     // m
-inline constexpr double kFitSigmaTheta = 0.05;  // rad
-
-// Sets the blocks of `model` to the MAP fit of `poses` (sigmas kFitSigmaXy
-// and kFitSigmaTheta) under the model's own prior: the initial value that
-// reproduces a pilot trajectory as closely as the model can. A model with a
-// rule of its own uses it (TrajectoryModel::SetBlocksFromPoses: WNOA
-// states); a time-ordered one is solved on its envelope (BANDED_CHOLESKY).
+// Sets the blocks of `model` to the MAP fit of `poses` (sigmas 0.05 m and
+// 0.05 rad) under the model's own prior: the initial value that reproduces
+// a pilot trajectory as closely as the model can. A model with a rule of
+// its own uses it (TrajectoryModel::SetBlocksFromPoses: WNOA states); a
+// time-ordered one is solved on its envelope (BANDED_CHOLESKY).
 bool FitModelToPoses(const std::vector<TimedPose>& poses,
                      TrajectoryModel* model, std::string* error);
+// The costs of that fit over the model's blocks: the model's prior and a
+// pose prior at each of `poses`.
+void AddPoseFitCosts(const std::vector<TimedPose>& poses,
+                     TrajectoryModel* model, ceres::Problem* problem);
 
 }  // namespace rff
 

@@ -8,10 +8,8 @@
 
 #include "ceres/problem.h"
 #include "ceres/solver.h"
-#include "costs/pose_prior_cost.h"
 #include "gtest/gtest.h"
 #include "rff_ceres/feature_trajectory.h"
-#include "rff_ceres/slam_problem.h"
 #include "rff_ceres/mean/mean_function.h"
 #include "rff_ceres/se2.h"
 
@@ -82,20 +80,7 @@ TEST(FitModelToPosesTest, WindowedFitIsCeresMap) {
   ASSERT_TRUE(FitModelToPoses(poses, fitted.get(), &error)) << error;
 
   ceres::Problem problem;
-  for (int b = 0; b < reference->num_blocks(); ++b) {
-    problem.AddParameterBlock(reference->mutable_block(b),
-                              reference->block_size(b));
-  }
-  reference->AddPriorCosts(&problem);
-  const Eigen::Vector3d sigma(kFitSigmaXy, kFitSigmaXy, kFitSigmaTheta);
-  for (const TimedPose& p : poses) {
-    PoseMap map = reference->PoseAt(p.t);
-    const std::vector<double*> blocks = BindPoseMaps(reference.get(), {&map});
-    problem.AddResidualBlock(
-        new PosePriorCost(std::move(map), Eigen::Vector3d(p.x, p.y, p.theta),
-                          sigma),
-        nullptr, blocks);
-  }
+  AddPoseFitCosts(poses, reference.get(), &problem);
   ceres::Solver::Options ceres_options;
   ceres_options.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
   ceres_options.function_tolerance = 1e-14;
