@@ -266,7 +266,10 @@ bool BandedProblem::RowProducts(const Eigen::VectorXd& x,
         for (int a = 0; a < term.num_blocks; ++a) {
           if (term.column[a] < 0) continue;
           const double* j = jacobian_rows_[a].data() + k * term.size[a];
+          // Most of a row's entries are zeros (a range on a state's
+          // heading, one axis's prior on another's): they add nothing.
           for (int i = 0; i < term.size[a]; ++i) {
+            if (j[i] == 0.0) continue;
             jz += j[i] * z.row(term.column[a] + i);
             ju += j[i] * u.row(term.column[a] + i);
           }

@@ -100,7 +100,7 @@ bool LearnScales(const Dataset& dataset,
   std::set<VarianceGroup> kept;  // Noise sigmas back at the stated ones.
   std::set<VarianceGroup> learned;  // Noise factors the data estimated.
   const ceres::Solver::Options placing_options = PlacingOptions(ceres_options);
-  SparseAnalysis analysis;  // The rounds' problems share one structure.
+  VarianceComponentCache cache;  // The rounds' problems share one structure.
   // The largest trust radius the solves reached: after rounds, the final
   // solve goes on from their point on their problem but for a rescale, so
   // it starts as trusting as they became (from the initial radius
@@ -119,7 +119,7 @@ bool LearnScales(const Dataset& dataset,
     VarianceComponents components;
     std::string why;
     if (!EstimateVarianceComponents(problem->get(), VarianceComponentOptions(),
-                                    &components, &why, &analysis)) {
+                                    &components, &why, &cache)) {
       // Data that leave part of the run beyond double precision (a pose
       // after a gap of days): the scales stay as they are, and say so.
       result->scales_not_learned = why;

@@ -1,6 +1,7 @@
 #include "rff_ceres/variance_components.h"
 
 #include <algorithm>
+#include <numeric>
 #include <random>
 #include <vector>
 
@@ -64,15 +65,38 @@ int ProbesPerPass(Eigen::Index rows, int most) {
       kMaxBatchEntries / std::max<Eigen::Index>(rows, 1), 1, most));
 }
 
-// `count` Rademacher probes over `n` columns, drawn probe by probe.
-Eigen::MatrixXd DrawProbes(Eigen::Index n, int count, std::mt19937* engine) {
-  Eigen::MatrixXd z(n, count);
-  // One bit per draw, without a branch: the bit is a coin flip the branch
-  // predictor would miss half the time.
-  for (int probe = 0; probe < count; ++probe) {
-    for (Eigen::Index i = 0; i < n; ++i) {
-      z(i, probe) =
-          static_cast<double>(2 * static_cast<int>((*engine)() & 1u) - 1);
+// The Rademacher probes' signs over `n` columns, probe after probe, one bit
+// per draw of mt19937(seed) (without a branch: the bit is a coin flip the
+// branch predictor would miss half the time). They depend on nothing else,
+// so the cache keeps them for the next call.
+const std::vector<signed char>& ProbeSigns(
+    Eigen::Index n, const VarianceComponentOptions& options,
+    VarianceComponentCache* cache) {
+  if (cache->columns != n || cache->probes != options.probes ||
+      cache->seed != options.seed) {
+    std::mt19937 engine(options.seed);
+    cache->signs.resize(static_cast<std::size_t>(n) * options.probes);
+    for (signed char& sign : cache->signs) {
+      sign = static_cast<signed char>(2 * static_cast<int>(engine() & 1u) - 1);
+    }
+    cache->columns = n;
+    cache->probes = options.probes;
+    cache->seed = options.seed;
+  }
+  return cache->signs;
+}
+
+// Probes `first` to `first + count` as the columns of a row-major matrix
+// whose row row_of[c] is column c's: placed row by row, so that no store
+// strides across the whole matrix.
+RowMajorDense PlaceProbes(const std::vector<signed char>& signs, int first,
+                          int count, const std::vector<int>& row_of) {
+  const std::size_t n = row_of.size();
+  RowMajorDense z(static_cast<Eigen::Index>(n), count);
+  for (std::size_t c = 0; c < n; ++c) {
+    double* row = z.row(row_of[c]).data();
+    for (int probe = 0; probe < count; ++probe) {
+      row[probe] = signs[(first + probe) * n + c];
     }
   }
   return z;
@@ -89,8 +113,8 @@ Eigen::MatrixXd DrawProbes(Eigen::Index n, int count, std::mt19937* engine) {
 // path's evaluation then reports. `traces` is written only on success.
 bool BandedTraces(SlamProblem* problem, const std::vector<double*>& ll_columns,
                   const std::vector<VarianceGroup>& groups,
-                  const VarianceComponentOptions& options, std::mt19937* engine,
-                  Eigen::VectorXd* residuals,
+                  const VarianceComponentOptions& options,
+                  VarianceComponentCache* cache, Eigen::VectorXd* residuals,
                   std::array<double, kNumVarianceGroups>* traces) {
   BandedSystem system;
   if (!FactorizeBanded(problem, &system)) return false;
@@ -112,13 +136,13 @@ bool BandedTraces(SlamProblem* problem, const std::vector<double*>& ll_columns,
     return false;
   }
   const int per_pass = ProbesPerPass(n, options.probes);
+  const std::vector<signed char>& signs = ProbeSigns(n, options, cache);
   Eigen::VectorXd products;
   std::array<double, kNumVarianceGroups> sums{};
   for (int first = 0; first < options.probes; first += per_pass) {
     const int count = std::min(per_pass, options.probes - first);
-    const Eigen::MatrixXd drawn = DrawProbes(n, count, engine);
-    EnvelopeMatrix::RowMajorMatrix z(n, count);
-    for (int c = 0; c < n; ++c) z.row(position[c]) = drawn.row(c);
+    const EnvelopeMatrix::RowMajorMatrix z =
+        PlaceProbes(signs, first, count, position);
     EnvelopeMatrix::RowMajorMatrix u = z;
     hessian.SolveInPlace(&u);
     if (!banded.RowProducts(x, z, u, residuals, &products)) return false;
@@ -131,14 +155,13 @@ bool BandedTraces(SlamProblem* problem, const std::vector<double*>& ll_columns,
 }
 
 // The same through the problem's sparse Jacobian and a GaussNewtonSystem
-// (any model; `analysis` kept between calls).
+// (any model; the cache's analysis kept between calls).
 bool SparseTraces(SlamProblem* problem, const std::vector<double*>& columns,
                   int num_leading,
                   const std::vector<ceres::ResidualBlockId>& ids,
                   const std::vector<VarianceGroup>& groups,
                   const VarianceComponentOptions& options,
-                  SparseAnalysis* analysis, std::mt19937* engine,
-                  Eigen::VectorXd* residuals,
+                  VarianceComponentCache* cache, Eigen::VectorXd* residuals,
                   std::array<double, kNumVarianceGroups>* traces,
                   std::string* error) {
   double cost = 0.0;
@@ -154,7 +177,7 @@ bool SparseTraces(SlamProblem* problem, const std::vector<double*>& columns,
   const GaussNewtonSystem hessian(
       jacobian, num_leading,
       banded ? Factorization::kEnvelopeOrSparse : Factorization::kSchurOrSparse,
-      analysis,
+      &cache->analysis,
       banded ? TimeOrderPositions(problem, columns) : std::vector<int>());
   if (!hessian.positive_definite()) {
     *error = "the Gauss-Newton Hessian is not positive definite";
@@ -162,10 +185,14 @@ bool SparseTraces(SlamProblem* problem, const std::vector<double*>& columns,
   }
   // Probes in batches: one pass over J and the factor per batch.
   const int per_pass = ProbesPerPass(jacobian.rows(), 8);
+  const std::vector<signed char>& signs =
+      ProbeSigns(jacobian.cols(), options, cache);
+  std::vector<int> in_order(jacobian.cols());
+  std::iota(in_order.begin(), in_order.end(), 0);
   for (int first = 0; first < options.probes; first += per_pass) {
     const int count = std::min(per_pass, options.probes - first);
-    const Eigen::MatrixXd z = DrawProbes(jacobian.cols(), count, engine);
-    const RowMajorDense jz = jacobian * RowMajorDense(z);
+    const RowMajorDense z = PlaceProbes(signs, first, count, in_order);
+    const RowMajorDense jz = jacobian * z;
     const RowMajorDense ju = jacobian * RowMajorDense(hessian.Solve(z));
     for (int probe = 0; probe < count; ++probe) {
       for (Eigen::Index r = 0; r < jz.rows(); ++r) {
@@ -181,21 +208,22 @@ bool SparseTraces(SlamProblem* problem, const std::vector<double*>& columns,
 bool EstimateVarianceComponents(SlamProblem* problem,
                                 const VarianceComponentOptions& options,
                                 VarianceComponents* components,
-                                std::string* error, SparseAnalysis* analysis) {
+                                std::string* error,
+                                VarianceComponentCache* cache) {
   *components = VarianceComponents();
+  VarianceComponentCache local;
+  if (cache == nullptr) cache = &local;
   std::vector<ceres::ResidualBlockId> ids;
   problem->problem()->GetResidualBlocks(&ids);
   const std::vector<VarianceGroup> groups = problem->RowGroups(ids);
   int num_leading = 0;
   const std::vector<double*> columns = LandmarksLast(problem, &num_leading);
   std::array<double, kNumVarianceGroups> traces{};
-  std::mt19937 engine(options.seed);
   Eigen::VectorXd residuals;
-  const bool banded = BandedTraces(problem, columns, groups, options, &engine,
+  const bool banded = BandedTraces(problem, columns, groups, options, cache,
                                    &residuals, &traces);
-  if (!banded &&
-      !SparseTraces(problem, columns, num_leading, ids, groups, options,
-                    analysis, &engine, &residuals, &traces, error)) {
+  if (!banded && !SparseTraces(problem, columns, num_leading, ids, groups,
+                               options, cache, &residuals, &traces, error)) {
     return false;
   }
   for (Eigen::Index r = 0; r < residuals.size(); ++r) {

@@ -47,15 +47,26 @@ struct VarianceComponentOptions {
 
 using VarianceComponents = std::array<VarianceComponent, kNumVarianceGroups>;
 
+// What calls on problems of one structure (a learning's rounds) share: the
+// sparse factorisation's analysis, and the probes, which depend only on the
+// number of columns, the probes and the seed.
+struct VarianceComponentCache {
+  SparseAnalysis analysis;
+  std::vector<signed char> signs;  // Probe after probe, `columns` each.
+  Eigen::Index columns = -1;
+  int probes = 0;
+  unsigned seed = 0;
+};
+
 // The factors at the problem's current values (call at a MAP). Fails when
 // the problem cannot be evaluated or its Hessian is not positive definite.
-// `analysis`, when given, keeps the sparse factorisation's analysis for
-// the next call on a problem of the same structure.
+// `cache`, when given, keeps what the next call on a problem of the same
+// structure can use again.
 bool EstimateVarianceComponents(SlamProblem* problem,
                                 const VarianceComponentOptions& options,
                                 VarianceComponents* components,
                                 std::string* error,
-                                SparseAnalysis* analysis = nullptr);
+                                VarianceComponentCache* cache = nullptr);
 
 // The residuals and Jacobian of `blocks` (in that order, through their
 // robust losses) at the problem's current values; the Jacobian's columns are

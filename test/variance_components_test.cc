@@ -402,6 +402,50 @@ TEST(VarianceComponentsTest, RedundanciesMatchTheExactTracesWnoa) {
   ExpectRedundanciesMatchTheExactTraces(options);
 }
 
+// A cache hands the next call the probes its seed draws: the same
+// components as without one, call after call; another seed draws anew.
+TEST(VarianceComponentsTest, CacheKeepsTheProbesOfItsSeed) {
+  const Dataset dataset = WnoaDraw(3, 40, 0.05, 0.01);
+  SlamOptions options;
+  options.prior = "wnoa";
+  std::unique_ptr<TrajectoryModel> model;
+  ModelAboutAConstantMean(dataset, options, &model);
+  ASSERT_NE(model, nullptr);
+  std::string error;
+  SlamProblem problem(model.get(), options.problem);
+  ASSERT_TRUE(
+      problem.Build(dataset, TrueLandmarks(dataset, {0.0, 0.0}), &error))
+      << error;
+  ceres::Solver::Options solver;
+  ceres::Solver::Summary summary;
+  ceres::Solve(solver, problem.problem(), &summary);
+
+  auto estimate = [&](unsigned seed, VarianceComponentCache* cache) {
+    VarianceComponentOptions vc;
+    vc.seed = seed;
+    VarianceComponents components;
+    EXPECT_TRUE(
+        EstimateVarianceComponents(&problem, vc, &components, &error, cache))
+        << error;
+    std::vector<double> redundancies;
+    for (const VarianceComponent& c : components) {
+      redundancies.push_back(c.redundancy);
+    }
+    return redundancies;
+  };
+  const std::vector<double> seed_1 = estimate(1, nullptr);
+  const std::vector<double> seed_2 = estimate(2, nullptr);
+  EXPECT_NE(seed_1, seed_2);
+  VarianceComponentCache cache;
+  EXPECT_EQ(estimate(1, &cache), seed_1);
+  EXPECT_EQ(cache.columns, problem.problem()->NumParameters());
+  EXPECT_EQ(cache.signs.size(),
+            static_cast<std::size_t>(cache.columns) * cache.probes);
+  EXPECT_EQ(estimate(1, &cache), seed_1);
+  EXPECT_EQ(estimate(2, &cache), seed_2);
+  EXPECT_EQ(cache.seed, 2u);
+}
+
 // The banded path's per-row residuals and probe products are those of the
 // problem's own Jacobian (Ceres's, through the Cauchy loss's correction),
 // its columns in the envelope's time order.

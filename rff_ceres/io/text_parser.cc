@@ -26,9 +26,11 @@ bool LineReader::Next(std::vector<std::string_view>* fields) {
     line_.clear();
     // Read one line by hand so that a huge line is refused before it is
     // held in memory whole.
+    // Through the stream's buffer: istream::get builds a sentry per char.
+    std::streambuf* buffer = input_->rdbuf();
     bool got_any = false;
     int c;
-    while ((c = input_->get()) != std::char_traits<char>::eof()) {
+    while ((c = buffer->sbumpc()) != std::char_traits<char>::eof()) {
       got_any = true;
       if (c == '\n') break;
       if (line_.size() >= kMaxLineLength) {
@@ -80,6 +82,15 @@ bool LineReader::Next(std::vector<std::string_view>* fields) {
 
 bool ParseFiniteDouble(std::string_view field, double* value) {
   if (field.empty() || field.size() > 64) return false;
+  // from_chars reads a subset of strtod's grammar (no '+', no hex) and
+  // rounds alike; what it does not take whole and finite, strtod decides.
+  double fast = 0.0;
+  const char* last = field.data() + field.size();
+  const std::from_chars_result read = std::from_chars(field.data(), last, fast);
+  if (read.ec == std::errc() && read.ptr == last && std::isfinite(fast)) {
+    *value = fast;
+    return true;
+  }
   char buffer[65];
   std::memcpy(buffer, field.data(), field.size());
   buffer[field.size()] = '\0';

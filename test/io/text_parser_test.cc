@@ -1,6 +1,7 @@
 #include "rff_ceres/io/text_parser.h"
 
 #include <cmath>
+#include <cstdlib>
 #include <sstream>
 
 #include "gtest/gtest.h"
@@ -22,6 +23,47 @@ TEST(TextParserTest, ParsesFiniteNumbersWhole) {
   EXPECT_FALSE(ParseFiniteDouble("-inf", &v));
   EXPECT_FALSE(ParseFiniteDouble("1e999", &v));
   EXPECT_FALSE(ParseFiniteDouble(std::string(100, '1'), &v));
+}
+
+// Every text it takes is strtod's number, bit for bit, whichever reader
+// took it: the fast one for plain decimals, strtod for the rest ('+',
+// hexadecimal, underflow) and for what neither takes.
+TEST(TextParserTest, ReadsWhatStrtodReads) {
+  for (const char* text : {"1248444175.103",
+                           "0.1",
+                           "-2.5e-7",
+                           "7",
+                           ".5",
+                           "5.",
+                           "1E+3",
+                           "+1.5",
+                           "0x1p-3",
+                           "1e-310",
+                           "1e-400",
+                           "-1e-400",
+                           "4.9406564584124654e-324",
+                           "1.7976931348623157e308",
+                           "00012.50",
+                           "1.5 ",
+                           " 1.5",
+                           "1,5",
+                           "0x",
+                           "+-1",
+                           "--1",
+                           "1e",
+                           "e5",
+                           "."}) {
+    char* end = nullptr;
+    const double expected = std::strtod(text, &end);
+    const bool whole = *end == '\0' && end != text;
+    double v = -123.0;
+    EXPECT_EQ(ParseFiniteDouble(text, &v), whole && std::isfinite(expected))
+        << text;
+    if (whole) {
+      EXPECT_EQ(v, expected) << text;
+      EXPECT_EQ(std::signbit(v), std::signbit(expected)) << text;
+    }
+  }
 }
 
 TEST(TextParserTest, ParsesNonNegativeIntegers) {
