@@ -24,13 +24,14 @@ void EnvelopeMatrix::SetZero() {
 }
 
 // L_ij for the `count` rows from `group` on, all stored from column `first`,
-// at every column j left of the group: one pass over row j for all of them,
+// at the columns j in [from, to): one pass over row j for all of them,
 // their sums independent chains.
 template <int kCount>
-void EnvelopeMatrix::EliminateRowsAlike(int group, int first) {
+void EnvelopeMatrix::EliminateRowsAlike(int group, int first, int from,
+                                        int to) {
   double* l[kCount];
   for (int r = 0; r < kCount; ++r) l[r] = row(group + r);
-  for (int j = first; j < group; ++j) {
+  for (int j = from; j < to; ++j) {
     const double* lj = row(j);
     const int fj = first_[j];
     const int k0 = std::max(first, fj);
@@ -47,6 +48,85 @@ void EnvelopeMatrix::EliminateRowsAlike(int group, int first) {
   }
 }
 
+// The same for `kCount` rows anywhere below, at columns j in [from, to)
+// whose rows start at or after every one of theirs: each sum runs over
+// row j's stored columns, as EliminateRowsAlike's would.
+template <int kCount>
+void EnvelopeMatrix::EliminateLongRows(const int* rows, int from, int to) {
+  double* l[kCount];
+  int f[kCount];
+  for (int r = 0; r < kCount; ++r) {
+    l[r] = row(rows[r]);
+    f[r] = first_[rows[r]];
+  }
+  for (int j = from; j < to; ++j) {
+    const double* lj = row(j);
+    const int fj = first_[j];
+    const double* a[kCount];
+    for (int r = 0; r < kCount; ++r) a[r] = l[r] + (fj - f[r]);
+    double sum[kCount] = {};
+    for (int k = 0; k < j - fj; ++k) {
+      for (int r = 0; r < kCount; ++r) sum[r] += a[r][k] * lj[k];
+    }
+    const double inverse = inverse_diagonal_[j];
+    for (int r = 0; r < kCount; ++r) {
+      l[r][j - f[r]] = (l[r][j - f[r]] - sum[r]) * inverse;
+    }
+  }
+}
+
+// A long group's columns left of it, with the long rows of the groups
+// after it (up to kMaxLongRows rows, whole groups): every row left of
+// `group` is final, so theirs there can be formed now, in one pass over
+// each row j for all of them. Landmarks seen over the whole run end the
+// envelope as a few long rows apart; one at a time, each sum is a chain
+// that waits on its last add.
+void EnvelopeMatrix::EliminateAhead(const std::vector<Group>& groups,
+                                    std::size_t at, std::vector<int>* from) {
+  constexpr int kMaxLongRows = 8;
+  const int group = groups[at].begin;
+  std::vector<int> rows;
+  for (std::size_t g = at; g < groups.size(); ++g) {
+    const Group& next = groups[g];
+    const int count = next.end - next.begin;
+    if (!next.is_long || (*from)[next.begin] >= group) continue;
+    if (static_cast<int>(rows.size()) + count > kMaxLongRows) break;
+    for (int i = next.begin; i < next.end; ++i) rows.push_back(i);
+  }
+  // Where every row j up to `group` starts at or after all of theirs.
+  int latest_first = 0, latest_from = 0;
+  for (const int i : rows) {
+    latest_first = std::max(latest_first, first_[i]);
+    latest_from = std::max(latest_from, (*from)[i]);
+  }
+  int uniform = group;
+  while (uniform > latest_from && first_[uniform - 1] >= latest_first) {
+    --uniform;
+  }
+  for (const int i : rows) {
+    EliminateRowsAlike<1>(i, first_[i], (*from)[i], uniform);
+    (*from)[i] = group;
+  }
+  switch (rows.size()) {
+    case 8:
+      return EliminateLongRows<8>(rows.data(), uniform, group);
+    case 7:
+      return EliminateLongRows<7>(rows.data(), uniform, group);
+    case 6:
+      return EliminateLongRows<6>(rows.data(), uniform, group);
+    case 5:
+      return EliminateLongRows<5>(rows.data(), uniform, group);
+    case 4:
+      return EliminateLongRows<4>(rows.data(), uniform, group);
+    case 3:
+      return EliminateLongRows<3>(rows.data(), uniform, group);
+    case 2:
+      return EliminateLongRows<2>(rows.data(), uniform, group);
+    default:
+      return EliminateLongRows<1>(rows.data(), uniform, group);
+  }
+}
+
 // Row by row (the "bordering" form): L_ij = (A_ij - sum_k L_ik L_jk) / L_jj
 // over the columns k both rows store, then L_ii = sqrt(A_ii - sum_k L_ik^2).
 // Each L_ij needs L_i,j-1, so a row is one chain of dependent operations:
@@ -55,7 +135,9 @@ void EnvelopeMatrix::EliminateRowsAlike(int group, int first) {
 bool EnvelopeMatrix::Factorize(Eigen::VectorXd* lower) {
   CHECK(lower == nullptr || lower->size() == size());
   constexpr int kMaxRowsAtOnce = 6;
-  using Eliminate = void (EnvelopeMatrix::*)(int, int);
+  // Rows this far right of their first column are long (landmarks).
+  constexpr int kLongRow = 256;
+  using Eliminate = void (EnvelopeMatrix::*)(int, int, int, int);
   static constexpr Eliminate kEliminate[kMaxRowsAtOnce + 1] = {
       nullptr,
       &EnvelopeMatrix::EliminateRowsAlike<1>,
@@ -64,15 +146,24 @@ bool EnvelopeMatrix::Factorize(Eigen::VectorXd* lower) {
       &EnvelopeMatrix::EliminateRowsAlike<4>,
       &EnvelopeMatrix::EliminateRowsAlike<5>,
       &EnvelopeMatrix::EliminateRowsAlike<6>};
-  int end = 0;
-  for (int group = 0; group < size(); group = end) {
-    const int first = first_[group];
+  std::vector<Group> groups;
+  for (int group = 0, end = 0; group < size(); group = end) {
     end = group + 1;
     while (end < size() && end - group < kMaxRowsAtOnce &&
-           first_[end] == first) {
+           first_[end] == first_[group]) {
       ++end;
     }
-    (this->*kEliminate[end - group])(group, first);
+    groups.push_back({group, end, group - first_[group] >= kLongRow});
+  }
+  // Row i's columns left of from[i] are final.
+  std::vector<int> from = first_;
+  for (std::size_t at = 0; at < groups.size(); ++at) {
+    const int group = groups[at].begin, end = groups[at].end;
+    const int first = first_[group];
+    if (groups[at].is_long && group - from[group] >= kLongRow) {
+      EliminateAhead(groups, at, &from);
+    }
+    (this->*kEliminate[end - group])(group, first, from[group], group);
     for (int i = group; i < end; ++i) {
       double* li = row(i);
       // The group's own triangle: row j of it stores from `first` too.

@@ -80,9 +80,20 @@ class EnvelopeMatrix {
   }
 
  private:
-  // Factorize's entries left of a group of rows that start alike.
+  // Factorize's rows taken together: consecutive ones that start alike,
+  // up to kMaxRowsAtOnce; long ones are those of landmarks.
+  struct Group {
+    int begin, end;
+    bool is_long;
+  };
+  // Factorize's entries left of a group of rows that start alike, at the
+  // columns [from, to).
   template <int kCount>
-  void EliminateRowsAlike(int group, int first);
+  void EliminateRowsAlike(int group, int first, int from, int to);
+  template <int kCount>
+  void EliminateLongRows(const int* rows, int from, int to);
+  void EliminateAhead(const std::vector<Group>& groups, std::size_t at,
+                      std::vector<int>* from);
   // Rows below the diagonal per column: how many, from `first`.
   static std::vector<int> ColumnCounts(const std::vector<int>& first);
 

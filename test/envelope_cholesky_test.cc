@@ -1,5 +1,7 @@
 #include "rff_ceres/envelope_cholesky.h"
 
+#include <algorithm>
+#include <cmath>
 #include <limits>
 #include <random>
 
@@ -111,11 +113,9 @@ TEST(EnvelopeCholeskyTest, FactorMatchesEigensWithBlocksOfEverySize) {
 // variables, each coupled to the next, and landmarks of 2 seen from
 // overlapping stretches of states, each placed after the last state that
 // sees it: long landmark rows that cross other landmarks' columns.
-Eigen::MatrixXd LandmarksSeenOverStretches(std::vector<int>* first) {
-  const int num_states = 200;
-  const std::vector<std::pair<int, int>> sightings = {
-      {0, 150},  {5, 40},   {10, 120},  {30, 60},   {45, 199},
-      {50, 130}, {90, 100}, {100, 180}, {110, 199}, {160, 190}};
+Eigen::MatrixXd LandmarksSeenFrom(
+    int num_states, const std::vector<std::pair<int, int>>& sightings,
+    std::vector<int>* first) {
   // Landmark k's columns come after state sightings[k].second's.
   std::vector<int> state_column(num_states), landmark_column(sightings.size());
   int next = 0;
@@ -171,6 +171,21 @@ Eigen::MatrixXd LandmarksSeenOverStretches(std::vector<int>* first) {
   return a;
 }
 
+Eigen::MatrixXd LandmarksSeenOverStretches(std::vector<int>* first) {
+  return LandmarksSeenFrom(200,
+                           {{0, 150},
+                            {5, 40},
+                            {10, 120},
+                            {30, 60},
+                            {45, 199},
+                            {50, 130},
+                            {90, 100},
+                            {100, 180},
+                            {110, 199},
+                            {160, 190}},
+                           first);
+}
+
 // Its factor is Eigen's, entry for entry.
 TEST(EnvelopeCholeskyTest, FactorMatchesEigensWithLandmarksSeenOverStretches) {
   std::vector<int> first;
@@ -184,6 +199,55 @@ TEST(EnvelopeCholeskyTest, FactorMatchesEigensWithLandmarksSeenOverStretches) {
     for (int k = 0; k <= i; ++k) {
       const double entry = k >= first[i] ? e(i, k) : 0.0;
       ASSERT_NEAR(entry, l(i, k), tolerance) << i << ", " << k;
+    }
+  }
+}
+
+// The bordering formula row by row, column by column: L_ij = (A_ij -
+// sum_k L_ik L_jk) * (1 / L_jj) over k from max(first(i), first(j)) up,
+// L_ii = sqrt(A_ii - L_i0^2 - L_i1^2 - ...), each sum in k order.
+Eigen::MatrixXd RowByRowFactor(const Eigen::MatrixXd& a,
+                               const std::vector<int>& first) {
+  const int n = static_cast<int>(a.rows());
+  Eigen::MatrixXd l = Eigen::MatrixXd::Zero(n, n);
+  Eigen::VectorXd inverse(n);
+  for (int i = 0; i < n; ++i) {
+    for (int j = first[i]; j < i; ++j) {
+      double sum = 0.0;
+      for (int k = std::max(first[i], first[j]); k < j; ++k) {
+        sum += l(i, k) * l(j, k);
+      }
+      l(i, j) = (a(i, j) - sum) * inverse[j];
+    }
+    double diagonal = a(i, i);
+    for (int k = first[i]; k < i; ++k) diagonal -= l(i, k) * l(i, k);
+    l(i, i) = std::sqrt(diagonal);
+    inverse[i] = 1.0 / l(i, i);
+  }
+  return l;
+}
+
+// However Factorize groups rows (states alike, landmarks' long rows ahead
+// of their turn, several at once), each entry is the formula's, bit for bit.
+// Landmarks seen over the whole run (Plaza's beacons) end the envelope
+// as long rows with states between them, more than one pass takes; others
+// cross them.
+TEST(EnvelopeCholeskyTest, FactorIsTheRowByRowFormulaBitForBit) {
+  std::vector<int> first;
+  const Eigen::MatrixXd a = LandmarksSeenFrom(
+      300,
+      {{0, 296}, {2, 297}, {40, 250}, {5, 298}, {9, 299}, {1, 299}, {3, 290}},
+      &first);
+  const int n = static_cast<int>(a.rows());
+  int long_rows = 0;  // Wider than Factorize's kLongRow.
+  for (int i = 0; i < n; ++i) long_rows += i - first[i] >= 256;
+  EXPECT_EQ(long_rows, 14);
+  EnvelopeMatrix e = FromDense(a, first);
+  ASSERT_TRUE(e.Factorize());
+  const Eigen::MatrixXd l = RowByRowFactor(a, first);
+  for (int i = 0; i < n; ++i) {
+    for (int k = first[i]; k <= i; ++k) {
+      ASSERT_EQ(e(i, k), l(i, k)) << i << ", " << k;
     }
   }
 }
