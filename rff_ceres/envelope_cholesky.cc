@@ -48,82 +48,137 @@ void EnvelopeMatrix::EliminateRowsAlike(int group, int first, int from,
   }
 }
 
-// The same for `kCount` rows anywhere below, at columns j in [from, to)
-// whose rows start at or after every one of theirs: each sum runs over
-// row j's stored columns, as EliminateRowsAlike's would.
+// The same for `kCount` rows anywhere below, at the columns j in [from,
+// to): each sum over the columns both rows store, in k order (a row's
+// own leading terms first, where it starts before the others). With
+// `lower`, also its rows' sums y_i - sum_j L_ij y_j over these columns.
 template <int kCount>
-void EnvelopeMatrix::EliminateLongRows(const int* rows, int from, int to) {
+void EnvelopeMatrix::EliminateLongRows(const int* rows, int from, int to,
+                                       double* lower) {
   double* l[kCount];
   int f[kCount];
+  double y[kCount];
+  int latest_first = 0;
   for (int r = 0; r < kCount; ++r) {
     l[r] = row(rows[r]);
     f[r] = first_[rows[r]];
+    y[r] = lower != nullptr ? lower[rows[r]] : 0.0;
+    latest_first = std::max(latest_first, f[r]);
   }
   for (int j = from; j < to; ++j) {
     const double* lj = row(j);
     const int fj = first_[j];
-    const double* a[kCount];
-    for (int r = 0; r < kCount; ++r) a[r] = l[r] + (fj - f[r]);
+    const int common = std::max(fj, latest_first);
     double sum[kCount] = {};
-    for (int k = 0; k < j - fj; ++k) {
-      for (int r = 0; r < kCount; ++r) sum[r] += a[r][k] * lj[k];
+    if (fj < latest_first) {
+      for (int r = 0; r < kCount; ++r) {
+        for (int k = std::max(f[r], fj); k < common; ++k) {
+          sum[r] += l[r][k - f[r]] * lj[k - fj];
+        }
+      }
+    }
+    const double* a[kCount];
+    for (int r = 0; r < kCount; ++r) a[r] = l[r] + (common - f[r]);
+    const double* b = lj + (common - fj);
+    for (int k = 0; k < j - common; ++k) {
+      for (int r = 0; r < kCount; ++r) sum[r] += a[r][k] * b[k];
     }
     const double inverse = inverse_diagonal_[j];
     for (int r = 0; r < kCount; ++r) {
       l[r][j - f[r]] = (l[r][j - f[r]] - sum[r]) * inverse;
     }
+    if (lower != nullptr) {
+      for (int r = 0; r < kCount; ++r) y[r] -= l[r][j - f[r]] * lower[j];
+    }
+  }
+  if (lower != nullptr) {
+    for (int r = 0; r < kCount; ++r) lower[rows[r]] = y[r];
   }
 }
 
-// A long group's columns left of it, with the long rows of the groups
-// after it (up to kMaxLongRows rows, whole groups): every row left of
-// `group` is final, so theirs there can be formed now, in one pass over
-// each row j for all of them. Landmarks seen over the whole run end the
-// envelope as a few long rows apart; one at a time, each sum is a chain
-// that waits on its last add.
+// A long group's columns left of it, with those of long groups after it
+// (up to kMaxLongRows rows, whole groups) that have most of that stretch
+// still to form: every row left of `group` is final, so theirs there can
+// be formed now, in one pass over each row j for all of them. Landmarks
+// seen over long stretches are long rows apart; a pair at a time, each
+// sum is a chain that waits on its last add.
 void EnvelopeMatrix::EliminateAhead(const std::vector<Group>& groups,
-                                    std::size_t at, std::vector<int>* from) {
+                                    std::size_t at, std::vector<int>* from,
+                                    double* lower) {
   constexpr int kMaxLongRows = 8;
+  constexpr std::size_t kMaxLookAhead = 64;  // Long groups considered.
+  using Eliminate = void (EnvelopeMatrix::*)(int, int, int, int);
+  static constexpr Eliminate kEliminate[kMaxLongRows + 1] = {
+      nullptr,
+      &EnvelopeMatrix::EliminateRowsAlike<1>,
+      &EnvelopeMatrix::EliminateRowsAlike<2>,
+      &EnvelopeMatrix::EliminateRowsAlike<3>,
+      &EnvelopeMatrix::EliminateRowsAlike<4>,
+      &EnvelopeMatrix::EliminateRowsAlike<5>,
+      &EnvelopeMatrix::EliminateRowsAlike<6>,
+      &EnvelopeMatrix::EliminateRowsAlike<7>,
+      &EnvelopeMatrix::EliminateRowsAlike<8>};
   const int group = groups[at].begin;
+  const int lead_from = (*from)[group];
+  // Followers that start forming at most halfway along the lead's stretch,
+  // those with the most of it first.
+  std::vector<std::pair<int, std::size_t>> candidates;  // (from, group)
+  for (std::size_t g = at + 1, seen = 0;
+       g < groups.size() && seen < kMaxLookAhead; ++g) {
+    if (!groups[g].is_long) continue;
+    ++seen;
+    const int next_from = (*from)[groups[g].begin];
+    if (next_from <= lead_from + (group - lead_from) / 2) {
+      candidates.emplace_back(next_from, g);
+    }
+  }
+  std::stable_sort(candidates.begin(), candidates.end());
+  std::vector<std::size_t> chosen = {at};
+  int count = groups[at].end - group;
+  for (const auto& [next_from, g] : candidates) {
+    const int size = groups[g].end - groups[g].begin;
+    if (count + size > kMaxLongRows) continue;
+    chosen.push_back(g);
+    count += size;
+  }
+  // Each group on its own up to where the last of them starts forming.
+  int start = 0;
+  for (const std::size_t g : chosen) {
+    start = std::max(start, (*from)[groups[g].begin]);
+  }
   std::vector<int> rows;
-  for (std::size_t g = at; g < groups.size(); ++g) {
-    const Group& next = groups[g];
-    const int count = next.end - next.begin;
-    if (!next.is_long || (*from)[next.begin] >= group) continue;
-    if (static_cast<int>(rows.size()) + count > kMaxLongRows) break;
-    for (int i = next.begin; i < next.end; ++i) rows.push_back(i);
-  }
-  // Where every row j up to `group` starts at or after all of theirs.
-  int latest_first = 0, latest_from = 0;
-  for (const int i : rows) {
-    latest_first = std::max(latest_first, first_[i]);
-    latest_from = std::max(latest_from, (*from)[i]);
-  }
-  int uniform = group;
-  while (uniform > latest_from && first_[uniform - 1] >= latest_first) {
-    --uniform;
-  }
-  for (const int i : rows) {
-    EliminateRowsAlike<1>(i, first_[i], (*from)[i], uniform);
-    (*from)[i] = group;
+  for (const std::size_t g : chosen) {
+    const int begin = groups[g].begin, end = groups[g].end;
+    const int first = first_[begin];
+    (this->*kEliminate[end - begin])(begin, first, (*from)[begin], start);
+    for (int i = begin; i < end; ++i) {
+      if (lower != nullptr) {
+        const double* li = row(i);
+        for (int k = (*from)[i]; k < start; ++k) {
+          lower[i] -= li[k - first] * lower[k];
+        }
+      }
+      (*from)[i] = group;
+      rows.push_back(i);
+    }
   }
   switch (rows.size()) {
     case 8:
-      return EliminateLongRows<8>(rows.data(), uniform, group);
+      return EliminateLongRows<8>(rows.data(), start, group, lower);
     case 7:
-      return EliminateLongRows<7>(rows.data(), uniform, group);
+      return EliminateLongRows<7>(rows.data(), start, group, lower);
     case 6:
-      return EliminateLongRows<6>(rows.data(), uniform, group);
+      return EliminateLongRows<6>(rows.data(), start, group, lower);
     case 5:
-      return EliminateLongRows<5>(rows.data(), uniform, group);
+      return EliminateLongRows<5>(rows.data(), start, group, lower);
     case 4:
-      return EliminateLongRows<4>(rows.data(), uniform, group);
+      return EliminateLongRows<4>(rows.data(), start, group, lower);
     case 3:
-      return EliminateLongRows<3>(rows.data(), uniform, group);
+      return EliminateLongRows<3>(rows.data(), start, group, lower);
     case 2:
-      return EliminateLongRows<2>(rows.data(), uniform, group);
+      return EliminateLongRows<2>(rows.data(), start, group, lower);
     default:
-      return EliminateLongRows<1>(rows.data(), uniform, group);
+      return EliminateLongRows<1>(rows.data(), start, group, lower);
   }
 }
 
@@ -155,13 +210,15 @@ bool EnvelopeMatrix::Factorize(Eigen::VectorXd* lower) {
     }
     groups.push_back({group, end, group - first_[group] >= kLongRow});
   }
-  // Row i's columns left of from[i] are final.
+  // Row i's columns left of from[i] are final, and with `lower` its sum
+  // over them taken from y_i.
   std::vector<int> from = first_;
   for (std::size_t at = 0; at < groups.size(); ++at) {
     const int group = groups[at].begin, end = groups[at].end;
     const int first = first_[group];
     if (groups[at].is_long && group - from[group] >= kLongRow) {
-      EliminateAhead(groups, at, &from);
+      EliminateAhead(groups, at, &from,
+                     lower != nullptr ? lower->data() : nullptr);
     }
     (this->*kEliminate[end - group])(group, first, from[group], group);
     for (int i = group; i < end; ++i) {
@@ -181,7 +238,8 @@ bool EnvelopeMatrix::Factorize(Eigen::VectorXd* lower) {
       if (lower != nullptr) {
         double& y = (*lower)[i];
         double sum = y;
-        for (int k = first; k < i; ++k) sum -= li[k - first] * (*lower)[k];
+        // Columns left of from[i] were taken ahead (EliminateAhead).
+        for (int k = from[i]; k < i; ++k) sum -= li[k - first] * (*lower)[k];
         y = sum / li[i - first];
       }
     }

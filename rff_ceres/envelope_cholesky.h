@@ -91,9 +91,9 @@ class EnvelopeMatrix {
   template <int kCount>
   void EliminateRowsAlike(int group, int first, int from, int to);
   template <int kCount>
-  void EliminateLongRows(const int* rows, int from, int to);
+  void EliminateLongRows(const int* rows, int from, int to, double* lower);
   void EliminateAhead(const std::vector<Group>& groups, std::size_t at,
-                      std::vector<int>* from);
+                      std::vector<int>* from, double* lower);
   // Rows below the diagonal per column: how many, from `first`.
   static std::vector<int> ColumnCounts(const std::vector<int>& first);
 

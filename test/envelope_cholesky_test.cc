@@ -250,6 +250,12 @@ TEST(EnvelopeCholeskyTest, FactorIsTheRowByRowFormulaBitForBit) {
       ASSERT_EQ(e(i, k), l(i, k)) << i << ", " << k;
     }
   }
+  // L^-1 b formed along, as SolveLower forms it after.
+  Eigen::VectorXd lower = Eigen::VectorXd::LinSpaced(n, -3.0, 5.0);
+  const Eigen::VectorXd expected = e.SolveLower(lower);
+  EnvelopeMatrix along = FromDense(a, first);
+  ASSERT_TRUE(along.Factorize(&lower));
+  for (int i = 0; i < n; ++i) ASSERT_EQ(lower[i], expected[i]) << i;
 }
 
 // The inverse on the envelope is the dense inverse there, for banded
