@@ -103,7 +103,8 @@ void EnvelopeMatrix::EliminateLongRows(const int* rows, int from, int to,
 // seen over long stretches are long rows apart; a pair at a time, each
 // sum is a chain that waits on its last add.
 void EnvelopeMatrix::EliminateAhead(const std::vector<Group>& groups,
-                                    std::size_t at, std::vector<int>* from,
+                                    const std::vector<std::size_t>& long_groups,
+                                    std::size_t lead, std::vector<int>* from,
                                     double* lower) {
   constexpr int kMaxLongRows = 8;
   constexpr std::size_t kMaxLookAhead = 64;  // Long groups considered.
@@ -118,15 +119,15 @@ void EnvelopeMatrix::EliminateAhead(const std::vector<Group>& groups,
       &EnvelopeMatrix::EliminateRowsAlike<6>,
       &EnvelopeMatrix::EliminateRowsAlike<7>,
       &EnvelopeMatrix::EliminateRowsAlike<8>};
+  const std::size_t at = long_groups[lead];
   const int group = groups[at].begin;
   const int lead_from = (*from)[group];
   // Followers that start forming at most halfway along the lead's stretch,
   // those with the most of it first.
   std::vector<std::pair<int, std::size_t>> candidates;  // (from, group)
-  for (std::size_t g = at + 1, seen = 0;
-       g < groups.size() && seen < kMaxLookAhead; ++g) {
-    if (!groups[g].is_long) continue;
-    ++seen;
+  const std::size_t last = std::min(long_groups.size(), lead + kMaxLookAhead);
+  for (std::size_t next = lead + 1; next < last; ++next) {
+    const std::size_t g = long_groups[next];
     const int next_from = (*from)[groups[g].begin];
     if (next_from <= lead_from + (group - lead_from) / 2) {
       candidates.emplace_back(next_from, g);
@@ -210,15 +211,22 @@ bool EnvelopeMatrix::Factorize(Eigen::VectorXd* lower) {
     }
     groups.push_back({group, end, group - first_[group] >= kLongRow});
   }
+  std::vector<std::size_t> long_groups;  // Their places in `groups`.
+  for (std::size_t at = 0; at < groups.size(); ++at) {
+    if (groups[at].is_long) long_groups.push_back(at);
+  }
   // Row i's columns left of from[i] are final, and with `lower` its sum
   // over them taken from y_i.
   std::vector<int> from = first_;
-  for (std::size_t at = 0; at < groups.size(); ++at) {
+  for (std::size_t at = 0, lead = 0; at < groups.size(); ++at) {
     const int group = groups[at].begin, end = groups[at].end;
     const int first = first_[group];
-    if (groups[at].is_long && group - from[group] >= kLongRow) {
-      EliminateAhead(groups, at, &from,
-                     lower != nullptr ? lower->data() : nullptr);
+    if (groups[at].is_long) {
+      if (group - from[group] >= kLongRow) {
+        EliminateAhead(groups, long_groups, lead, &from,
+                       lower != nullptr ? lower->data() : nullptr);
+      }
+      ++lead;
     }
     (this->*kEliminate[end - group])(group, first, from[group], group);
     for (int i = group; i < end; ++i) {

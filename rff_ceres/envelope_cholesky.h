@@ -92,8 +92,11 @@ class EnvelopeMatrix {
   void EliminateRowsAlike(int group, int first, int from, int to);
   template <int kCount>
   void EliminateLongRows(const int* rows, int from, int to, double* lower);
-  void EliminateAhead(const std::vector<Group>& groups, std::size_t at,
-                      std::vector<int>* from, double* lower);
+  // The long group long_groups[lead] of `groups`, with followers.
+  void EliminateAhead(const std::vector<Group>& groups,
+                      const std::vector<std::size_t>& long_groups,
+                      std::size_t lead, std::vector<int>* from,
+                      double* lower);
   // Rows below the diagonal per column: how many, from `first`.
   static std::vector<int> ColumnCounts(const std::vector<int>& first);
 
