@@ -48,6 +48,17 @@ void EnvelopeMatrix::EliminateRowsAlike(int group, int first, int from,
   }
 }
 
+const EnvelopeMatrix::Eliminate EnvelopeMatrix::kEliminateRowsAlike[9] = {
+    nullptr,
+    &EnvelopeMatrix::EliminateRowsAlike<1>,
+    &EnvelopeMatrix::EliminateRowsAlike<2>,
+    &EnvelopeMatrix::EliminateRowsAlike<3>,
+    &EnvelopeMatrix::EliminateRowsAlike<4>,
+    &EnvelopeMatrix::EliminateRowsAlike<5>,
+    &EnvelopeMatrix::EliminateRowsAlike<6>,
+    &EnvelopeMatrix::EliminateRowsAlike<7>,
+    &EnvelopeMatrix::EliminateRowsAlike<8>};
+
 // The same for `kCount` rows anywhere below, at the columns j in [from,
 // to): each sum over the columns both rows store, in k order (a row's
 // own leading terms first, where it starts before the others). With
@@ -108,17 +119,6 @@ void EnvelopeMatrix::EliminateAhead(const std::vector<Group>& groups,
                                     double* lower) {
   constexpr int kMaxLongRows = 8;
   constexpr std::size_t kMaxLookAhead = 64;  // Long groups considered.
-  using Eliminate = void (EnvelopeMatrix::*)(int, int, int, int);
-  static constexpr Eliminate kEliminate[kMaxLongRows + 1] = {
-      nullptr,
-      &EnvelopeMatrix::EliminateRowsAlike<1>,
-      &EnvelopeMatrix::EliminateRowsAlike<2>,
-      &EnvelopeMatrix::EliminateRowsAlike<3>,
-      &EnvelopeMatrix::EliminateRowsAlike<4>,
-      &EnvelopeMatrix::EliminateRowsAlike<5>,
-      &EnvelopeMatrix::EliminateRowsAlike<6>,
-      &EnvelopeMatrix::EliminateRowsAlike<7>,
-      &EnvelopeMatrix::EliminateRowsAlike<8>};
   const std::size_t at = long_groups[lead];
   const int group = groups[at].begin;
   const int lead_from = (*from)[group];
@@ -151,7 +151,8 @@ void EnvelopeMatrix::EliminateAhead(const std::vector<Group>& groups,
   for (const std::size_t g : chosen) {
     const int begin = groups[g].begin, end = groups[g].end;
     const int first = first_[begin];
-    (this->*kEliminate[end - begin])(begin, first, (*from)[begin], start);
+    (this->*kEliminateRowsAlike[end - begin])(begin, first, (*from)[begin],
+                                              start);
     for (int i = begin; i < end; ++i) {
       if (lower != nullptr) {
         const double* li = row(i);
@@ -163,24 +164,18 @@ void EnvelopeMatrix::EliminateAhead(const std::vector<Group>& groups,
       rows.push_back(i);
     }
   }
-  switch (rows.size()) {
-    case 8:
-      return EliminateLongRows<8>(rows.data(), start, group, lower);
-    case 7:
-      return EliminateLongRows<7>(rows.data(), start, group, lower);
-    case 6:
-      return EliminateLongRows<6>(rows.data(), start, group, lower);
-    case 5:
-      return EliminateLongRows<5>(rows.data(), start, group, lower);
-    case 4:
-      return EliminateLongRows<4>(rows.data(), start, group, lower);
-    case 3:
-      return EliminateLongRows<3>(rows.data(), start, group, lower);
-    case 2:
-      return EliminateLongRows<2>(rows.data(), start, group, lower);
-    default:
-      return EliminateLongRows<1>(rows.data(), start, group, lower);
-  }
+  using EliminateLong = void (EnvelopeMatrix::*)(const int*, int, int, double*);
+  static constexpr EliminateLong kEliminateLong[kMaxLongRows + 1] = {
+      nullptr,
+      &EnvelopeMatrix::EliminateLongRows<1>,
+      &EnvelopeMatrix::EliminateLongRows<2>,
+      &EnvelopeMatrix::EliminateLongRows<3>,
+      &EnvelopeMatrix::EliminateLongRows<4>,
+      &EnvelopeMatrix::EliminateLongRows<5>,
+      &EnvelopeMatrix::EliminateLongRows<6>,
+      &EnvelopeMatrix::EliminateLongRows<7>,
+      &EnvelopeMatrix::EliminateLongRows<8>};
+  (this->*kEliminateLong[rows.size()])(rows.data(), start, group, lower);
 }
 
 // Row by row (the "bordering" form): L_ij = (A_ij - sum_k L_ik L_jk) / L_jj
@@ -193,15 +188,6 @@ bool EnvelopeMatrix::Factorize(Eigen::VectorXd* lower) {
   constexpr int kMaxRowsAtOnce = 6;
   // Rows this far right of their first column are long (landmarks).
   constexpr int kLongRow = 256;
-  using Eliminate = void (EnvelopeMatrix::*)(int, int, int, int);
-  static constexpr Eliminate kEliminate[kMaxRowsAtOnce + 1] = {
-      nullptr,
-      &EnvelopeMatrix::EliminateRowsAlike<1>,
-      &EnvelopeMatrix::EliminateRowsAlike<2>,
-      &EnvelopeMatrix::EliminateRowsAlike<3>,
-      &EnvelopeMatrix::EliminateRowsAlike<4>,
-      &EnvelopeMatrix::EliminateRowsAlike<5>,
-      &EnvelopeMatrix::EliminateRowsAlike<6>};
   std::vector<Group> groups;
   for (int group = 0, end = 0; group < size(); group = end) {
     end = group + 1;
@@ -228,7 +214,7 @@ bool EnvelopeMatrix::Factorize(Eigen::VectorXd* lower) {
       }
       ++lead;
     }
-    (this->*kEliminate[end - group])(group, first, from[group], group);
+    (this->*kEliminateRowsAlike[end - group])(group, first, from[group], group);
     for (int i = group; i < end; ++i) {
       double* li = row(i);
       // The group's own triangle: row j of it stores from `first` too.

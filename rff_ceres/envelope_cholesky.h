@@ -87,9 +87,11 @@ class EnvelopeMatrix {
     bool is_long;
   };
   // Factorize's entries left of a group of rows that start alike, at the
-  // columns [from, to).
+  // columns [from, to); kEliminateRowsAlike[count] for `count` rows.
   template <int kCount>
   void EliminateRowsAlike(int group, int first, int from, int to);
+  using Eliminate = void (EnvelopeMatrix::*)(int, int, int, int);
+  static const Eliminate kEliminateRowsAlike[9];
   template <int kCount>
   void EliminateLongRows(const int* rows, int from, int to, double* lower);
   // The long group long_groups[lead] of `groups`, with followers.

@@ -146,6 +146,17 @@ void ModelAboutAConstantMean(const Dataset& dataset, const SlamOptions& options,
   ASSERT_NE(*model, nullptr) << error;
 }
 
+// A short WNOA draw with its WNOA model about a constant mean.
+struct WnoaDrawModel {
+  WnoaDrawModel() {
+    options.prior = "wnoa";
+    ModelAboutAConstantMean(dataset, options, &model);
+  }
+  Dataset dataset = WnoaDraw(3, 40, 0.05, 0.01);
+  SlamOptions options;
+  std::unique_ptr<TrajectoryModel> model;
+};
+
 std::map<LandmarkId, Eigen::Vector2d> TrueLandmarks(
     const Dataset& dataset, const Eigen::Vector2d& offset) {
   std::map<LandmarkId, Eigen::Vector2d> landmarks;
@@ -405,16 +416,12 @@ TEST(VarianceComponentsTest, RedundanciesMatchTheExactTracesWnoa) {
 // A cache hands the next call the probes its seed draws: the same
 // components as without one, call after call; another seed draws anew.
 TEST(VarianceComponentsTest, CacheKeepsTheProbesOfItsSeed) {
-  const Dataset dataset = WnoaDraw(3, 40, 0.05, 0.01);
-  SlamOptions options;
-  options.prior = "wnoa";
-  std::unique_ptr<TrajectoryModel> model;
-  ModelAboutAConstantMean(dataset, options, &model);
-  ASSERT_NE(model, nullptr);
+  const WnoaDrawModel draw;
+  ASSERT_NE(draw.model, nullptr);
   std::string error;
-  SlamProblem problem(model.get(), options.problem);
-  ASSERT_TRUE(
-      problem.Build(dataset, TrueLandmarks(dataset, {0.0, 0.0}), &error))
+  SlamProblem problem(draw.model.get(), draw.options.problem);
+  ASSERT_TRUE(problem.Build(draw.dataset,
+                            TrueLandmarks(draw.dataset, {0.0, 0.0}), &error))
       << error;
   ceres::Solver::Options solver;
   ceres::Solver::Summary summary;
@@ -450,12 +457,11 @@ TEST(VarianceComponentsTest, CacheKeepsTheProbesOfItsSeed) {
 // problem's own Jacobian (Ceres's, through the Cauchy loss's correction),
 // its columns in the envelope's time order.
 TEST(VarianceComponentsTest, BandedRowProductsAreThoseOfTheJacobian) {
-  const Dataset dataset = WnoaDraw(3, 40, 0.05, 0.01);
-  SlamOptions options;
-  options.prior = "wnoa";
-  std::unique_ptr<TrajectoryModel> model;
-  ModelAboutAConstantMean(dataset, options, &model);
-  ASSERT_NE(model, nullptr);
+  WnoaDrawModel draw;
+  ASSERT_NE(draw.model, nullptr);
+  const Dataset& dataset = draw.dataset;
+  SlamOptions& options = draw.options;
+  const std::unique_ptr<TrajectoryModel>& model = draw.model;
   std::map<LandmarkId, Eigen::Vector2d> landmarks =
       TrueLandmarks(dataset, Eigen::Vector2d::Zero());
   for (auto& [id, position] : landmarks) position += Eigen::Vector2d(0.3, -0.2);
