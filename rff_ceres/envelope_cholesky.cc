@@ -48,16 +48,14 @@ void EnvelopeMatrix::EliminateRowsAlike(int group, int first, int from,
   }
 }
 
-const EnvelopeMatrix::Eliminate EnvelopeMatrix::kEliminateRowsAlike[9] = {
+const EnvelopeMatrix::Eliminate EnvelopeMatrix::kEliminateRowsAlike[7] = {
     nullptr,
     &EnvelopeMatrix::EliminateRowsAlike<1>,
     &EnvelopeMatrix::EliminateRowsAlike<2>,
     &EnvelopeMatrix::EliminateRowsAlike<3>,
     &EnvelopeMatrix::EliminateRowsAlike<4>,
     &EnvelopeMatrix::EliminateRowsAlike<5>,
-    &EnvelopeMatrix::EliminateRowsAlike<6>,
-    &EnvelopeMatrix::EliminateRowsAlike<7>,
-    &EnvelopeMatrix::EliminateRowsAlike<8>};
+    &EnvelopeMatrix::EliminateRowsAlike<6>};
 
 // The same for `kCount` rows anywhere below, at the columns j in [from,
 // to): each sum over the columns both rows store, in k order (a row's
@@ -108,62 +106,16 @@ void EnvelopeMatrix::EliminateLongRows(const int* rows, int from, int to,
 }
 
 // A long group's columns left of it, with those of long groups after it
-// (up to kMaxLongRows rows, whole groups) that have most of that stretch
-// still to form: every row left of `group` is final, so theirs there can
-// be formed now, in one pass over each row j for all of them. Landmarks
-// seen over long stretches are long rows apart; a pair at a time, each
-// sum is a chain that waits on its last add.
+// (up to kMaxLongRows rows, whole groups): every row left of `group` is
+// final, so theirs there can be formed now, in one pass over each row j
+// for all of them. Landmarks seen over long stretches are long rows
+// apart; a pair at a time, each sum is a chain that waits on its last add.
 void EnvelopeMatrix::EliminateAhead(const std::vector<Group>& groups,
                                     const std::vector<std::size_t>& long_groups,
                                     std::size_t lead, std::vector<int>* from,
                                     double* lower) {
   constexpr int kMaxLongRows = 8;
   constexpr std::size_t kMaxLookAhead = 64;  // Long groups considered.
-  const std::size_t at = long_groups[lead];
-  const int group = groups[at].begin;
-  const int lead_from = (*from)[group];
-  // Followers that start forming at most halfway along the lead's stretch,
-  // those with the most of it first.
-  std::vector<std::pair<int, std::size_t>> candidates;  // (from, group)
-  const std::size_t last = std::min(long_groups.size(), lead + kMaxLookAhead);
-  for (std::size_t next = lead + 1; next < last; ++next) {
-    const std::size_t g = long_groups[next];
-    const int next_from = (*from)[groups[g].begin];
-    if (next_from <= lead_from + (group - lead_from) / 2) {
-      candidates.emplace_back(next_from, g);
-    }
-  }
-  std::stable_sort(candidates.begin(), candidates.end());
-  std::vector<std::size_t> chosen = {at};
-  int count = groups[at].end - group;
-  for (const auto& [next_from, g] : candidates) {
-    const int size = groups[g].end - groups[g].begin;
-    if (count + size > kMaxLongRows) continue;
-    chosen.push_back(g);
-    count += size;
-  }
-  // Each group on its own up to where the last of them starts forming.
-  int start = 0;
-  for (const std::size_t g : chosen) {
-    start = std::max(start, (*from)[groups[g].begin]);
-  }
-  std::vector<int> rows;
-  for (const std::size_t g : chosen) {
-    const int begin = groups[g].begin, end = groups[g].end;
-    const int first = first_[begin];
-    (this->*kEliminateRowsAlike[end - begin])(begin, first, (*from)[begin],
-                                              start);
-    for (int i = begin; i < end; ++i) {
-      if (lower != nullptr) {
-        const double* li = row(i);
-        for (int k = (*from)[i]; k < start; ++k) {
-          lower[i] -= li[k - first] * lower[k];
-        }
-      }
-      (*from)[i] = group;
-      rows.push_back(i);
-    }
-  }
   using EliminateLong = void (EnvelopeMatrix::*)(const int*, int, int, double*);
   static constexpr EliminateLong kEliminateLong[kMaxLongRows + 1] = {
       nullptr,
@@ -175,7 +127,38 @@ void EnvelopeMatrix::EliminateAhead(const std::vector<Group>& groups,
       &EnvelopeMatrix::EliminateLongRows<6>,
       &EnvelopeMatrix::EliminateLongRows<7>,
       &EnvelopeMatrix::EliminateLongRows<8>};
-  (this->*kEliminateLong[rows.size()])(rows.data(), start, group, lower);
+  const std::size_t at = long_groups[lead];
+  const int group = groups[at].begin;
+  // Followers: the next long groups with entries left of `group` still to
+  // form, those that start forming earliest first.
+  std::vector<std::pair<int, std::size_t>> candidates;  // (from, group)
+  const std::size_t last = std::min(long_groups.size(), lead + kMaxLookAhead);
+  for (std::size_t next = lead + 1; next < last; ++next) {
+    const std::size_t g = long_groups[next];
+    if ((*from)[groups[g].begin] < group) {
+      candidates.emplace_back((*from)[groups[g].begin], g);
+    }
+  }
+  std::stable_sort(candidates.begin(), candidates.end());
+  std::vector<std::pair<int, std::size_t>> chosen = {{(*from)[group], at}};
+  int count = groups[at].end - group;
+  for (const auto& [next_from, g] : candidates) {
+    const int size = groups[g].end - groups[g].begin;
+    if (count + size > kMaxLongRows) continue;
+    chosen.emplace_back(next_from, g);
+    count += size;
+  }
+  std::stable_sort(chosen.begin(), chosen.end());
+  // Staggered: from where each group starts forming, it joins those that
+  // started before it, up to where the next one starts.
+  std::vector<int> rows;
+  for (std::size_t c = 0; c < chosen.size(); ++c) {
+    const auto [start, g] = chosen[c];
+    for (int i = groups[g].begin; i < groups[g].end; ++i) rows.push_back(i);
+    const int end = c + 1 < chosen.size() ? chosen[c + 1].first : group;
+    (this->*kEliminateLong[rows.size()])(rows.data(), start, end, lower);
+  }
+  for (const int i : rows) (*from)[i] = group;
 }
 
 // Row by row (the "bordering" form): L_ij = (A_ij - sum_k L_ik L_jk) / L_jj

@@ -91,7 +91,7 @@ class EnvelopeMatrix {
   template <int kCount>
   void EliminateRowsAlike(int group, int first, int from, int to);
   using Eliminate = void (EnvelopeMatrix::*)(int, int, int, int);
-  static const Eliminate kEliminateRowsAlike[9];
+  static const Eliminate kEliminateRowsAlike[7];
   template <int kCount>
   void EliminateLongRows(const int* rows, int from, int to, double* lower);
   // The long group long_groups[lead] of `groups`, with followers.
