@@ -75,7 +75,8 @@ const std::vector<signed char>& ProbeSigns(
   if (cache->columns != n || cache->probes != options.probes ||
       cache->seed != options.seed) {
     std::mt19937 engine(options.seed);
-    cache->signs.resize(static_cast<std::size_t>(n) * options.probes);
+    cache->signs.resize(static_cast<std::size_t>(n) *
+                        std::max(options.probes, 0));
     for (signed char& sign : cache->signs) {
       sign = static_cast<signed char>(2 * static_cast<int>(engine() & 1u) - 1);
     }

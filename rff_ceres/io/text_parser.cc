@@ -25,21 +25,27 @@ bool LineReader::Next(std::vector<std::string_view>* fields) {
     comment_ = std::string_view();
     line_.clear();
     // Read one line by hand so that a huge line is refused before it is
-    // held in memory whole.
-    // Through the stream's buffer: istream::get builds a sentry per char.
+    // held in memory whole, through the stream's buffer (istream::get
+    // builds a sentry per char). A failed read throws there (libstdc++'s
+    // filebuf) where get would set badbit: a read error either way.
     std::streambuf* buffer = input_->rdbuf();
     bool got_any = false;
-    int c;
-    while ((c = buffer->sbumpc()) != std::char_traits<char>::eof()) {
-      got_any = true;
-      if (c == '\n') break;
-      if (line_.size() >= kMaxLineLength) {
-        ++line_number_;
-        error_ = Error("line longer than " + std::to_string(kMaxLineLength) +
-                       " bytes (binary or broken file?)");
-        return false;
+    try {
+      int c;
+      while ((c = buffer->sbumpc()) != std::char_traits<char>::eof()) {
+        got_any = true;
+        if (c == '\n') break;
+        if (line_.size() >= kMaxLineLength) {
+          ++line_number_;
+          error_ = Error("line longer than " + std::to_string(kMaxLineLength) +
+                         " bytes (binary or broken file?)");
+          return false;
+        }
+        line_.push_back(static_cast<char>(c));
       }
-      line_.push_back(static_cast<char>(c));
+    } catch (const std::exception&) {
+      error_ = Error("read error");
+      return false;
     }
     if (!got_any) {
       if (input_->bad()) error_ = Error("read error");

@@ -2,7 +2,11 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <ios>
 #include <sstream>
+#include <streambuf>
+#include <string>
+#include <vector>
 
 #include "gtest/gtest.h"
 
@@ -94,6 +98,43 @@ TEST(TextParserTest, FormatNumberRoundTrips) {
     EXPECT_EQ(back, v);
   }
   EXPECT_EQ(FormatNumber(42.0), "42");
+}
+
+// A stream buffer whose reads fail after `good` characters, throwing as
+// libstdc++'s filebuf does on an I/O error.
+class FailingBuffer : public std::streambuf {
+ public:
+  explicit FailingBuffer(std::string good) : good_(std::move(good)) {
+    setg(good_.data(), good_.data(), good_.data() + good_.size());
+  }
+
+ protected:
+  int_type underflow() override {
+    throw std::ios_base::failure("Input/output error");
+  }
+
+ private:
+  std::string good_;
+};
+
+// A failed read is a read error, before or within a line: never a crash,
+// and never the part of a line read before it.
+TEST(TextParserTest, AFailedReadIsAReadError) {
+  for (const std::string& good :
+       {std::string(), std::string("a b\nc d"), std::string("a b\n")}) {
+    FailingBuffer buffer(good);
+    std::istream in(&buffer);
+    LineReader reader(&in, "f.txt");
+    std::vector<std::string_view> fields;
+    if (good.find('\n') != std::string::npos) {
+      ASSERT_TRUE(reader.Next(&fields));
+      EXPECT_EQ(fields, (std::vector<std::string_view>{"a", "b"}));
+    }
+    EXPECT_FALSE(reader.Next(&fields)) << good;
+    EXPECT_FALSE(reader.ok()) << good;
+    EXPECT_EQ(reader.error(),
+              good.empty() ? "f.txt:0: read error" : "f.txt:1: read error");
+  }
 }
 
 TEST(TextParserTest, SplitsFieldsSkipsCommentsAndCountsLines) {
