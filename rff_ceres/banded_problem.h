@@ -5,6 +5,7 @@
 #ifndef RFF_CERES_BANDED_PROBLEM_H_
 #define RFF_CERES_BANDED_PROBLEM_H_
 
+#include <algorithm>
 #include <cstdint>
 #include <memory>
 #include <unordered_map>
@@ -45,6 +46,12 @@ struct BandedSize {
   int num_columns = 0;
   std::int64_t entries = 0;
   double multiply_adds = 0.0;
+  // Whether its factorisation costs at most kMaxEnvelopeWorkPerVariable
+  // multiply-adds per variable (envelope_cholesky.h).
+  bool WorkWithinBound() const {
+    return multiply_adds <=
+           kMaxEnvelopeWorkPerVariable * std::max(num_columns, 1);
+  }
 };
 
 class BandedProblem {

@@ -256,8 +256,7 @@ double GaussNewtonDecrease(SlamProblem* problem, bool* exact) {
 
 bool EnvelopeAffordable(const BandedSize& size) {
   return static_cast<double>(size.entries) <= kMaxDenseEntries &&
-         size.multiply_adds <=
-             kMaxEnvelopeWorkPerVariable * std::max(size.num_columns, 1);
+         size.WorkWithinBound();
 }
 
 bool SchurFormFits(int t, Eigen::Index m) {

@@ -11,7 +11,6 @@
 #include "costs/pose_prior_cost.h"
 #include "rff_ceres/banded_minimizer.h"
 #include "rff_ceres/dead_reckoning.h"
-#include "rff_ceres/envelope_cholesky.h"
 #include "rff_ceres/mean_rotation.h"
 #include "rff_ceres/se2.h"
 #include "rff_ceres/slam_problem.h"
@@ -78,11 +77,7 @@ bool FitModelToPosesOnce(const std::vector<TimedPose>& poses,
   std::unique_ptr<BandedProblem> banded;
   if (BandedSolvable(problem, columns, &why)) {
     banded = std::make_unique<BandedProblem>(problem, columns);
-    const BandedSize size = banded->Size();
-    if (size.multiply_adds >
-        kMaxEnvelopeWorkPerVariable * std::max(size.num_columns, 1)) {
-      banded.reset();
-    }
+    if (!banded->Size().WorkWithinBound()) banded.reset();
   }
   if (banded) {
     MinimizeBanded(options, banded.get(), &problem, &summary);
