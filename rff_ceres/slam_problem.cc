@@ -246,10 +246,12 @@ bool OdometryChains(const Dataset& dataset, const ProblemOptions& options,
                                  options.max_preintegration_seconds);
   for (const PreintegratedOdometry& o : *chains) {
     if (!SqrtInformation(o.covariance).allFinite()) {
+      // Sigmas beyond 1e154 square past the largest double.
       *error = "odometry from t = " + FormatNumber(o.t0) + " to " +
                FormatNumber(o.t1) +
                ": its covariance cannot be inverted in double precision "
-               "(sigmas too small)";
+               "(sigmas too " +
+               (o.covariance.allFinite() ? "small" : "large") + ")";
       return false;
     }
   }

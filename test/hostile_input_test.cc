@@ -17,6 +17,7 @@
 #include "rff_ceres/io/landmarks_io.h"
 #include "rff_ceres/io/text_parser.h"
 #include "rff_ceres/io/tum_io.h"
+#include "rff_ceres/slam_solver.h"
 #include "test/test_files.h"
 
 namespace rff {
@@ -248,6 +249,28 @@ TEST(HostileRffdAcceptedTest, DuplicatedMeasurementsAreKept) {
   EXPECT_EQ(d.odometry.size(), 2u);
   ASSERT_EQ(d.observations.size(), 3u);
   EXPECT_EQ(d.observations[2].range, 4.0);  // Stable: file order kept.
+}
+
+// An odometry sigma whose square overflows is named as too large, not too
+// small, before any solve; a valid file (sigmas are only "> 0" there).
+TEST(HostileRffdAcceptedTest, OdometrySigmaTooLargeIsNamedSo) {
+  Dataset d;
+  std::string error;
+  ASSERT_TRUE(ParseRffd(std::string(kHead) + "PRIOR_LANDMARK 1 3 0 1\n"
+                                             "ODOM 0 1 1 0 0 1e200 0.1 0.01\n"
+                                             "RANGE 1 1 2 0.1\n",
+                        &d, &error))
+      << error;
+  SlamResult result;
+  for (const char* prior : {"rff", "wnoa"}) {
+    SlamOptions options;
+    options.prior = prior;
+    EXPECT_FALSE(RunSlam(d, options, &result, &error)) << prior;
+    EXPECT_EQ(error,
+              "odometry from t = 0 to 1: its covariance cannot be inverted "
+              "in double precision (sigmas too large)")
+        << prior;
+  }
 }
 
 // FORMAT.md: "Records may come in any order; readers sort observations by

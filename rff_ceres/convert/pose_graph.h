@@ -7,6 +7,7 @@
 
 #include <Eigen/Core>
 #include <cstddef>
+#include <istream>
 #include <ostream>
 #include <sstream>
 #include <string>
@@ -70,14 +71,24 @@ std::vector<double> DiagonalUpperTriangle(const std::vector<double>& sigmas,
 std::string JoinNumbers(const std::vector<double>& values);
 
 // Writes the text a format's stream writer `write` makes of `dataset` to
-// `path`, whole or not at all (WriteOutputFile).
+// `path`, whole or not at all (WriteOutputFile), and never a text the
+// format's reader `read_back` refuses (a sigma whose square overflows or
+// whose information underflows): it names the refusal instead.
 template <typename Summary>
 bool WriteGraphFile(bool (*write)(const Dataset&, std::ostream*, Summary*,
                                   std::string*),
+                    bool (*read_back)(std::istream*, const std::string&,
+                                      std::string*),
                     const Dataset& dataset, const std::string& path,
                     Summary* summary, std::string* error) {
   std::ostringstream text;
   if (!write(dataset, &text, summary, error)) return false;
+  std::istringstream written(text.str());
+  std::string why;
+  if (!read_back(&written, path, &why)) {
+    *error = path + ": not written: its reader would refuse it: " + why;
+    return false;
+  }
   return WriteOutputFile(
       path, [&](std::ostream* out) { *out << text.str(); }, error);
 }

@@ -88,6 +88,12 @@ bool CheckFlagfile(const std::string& path, const FlagIsKnown& is_known,
     *error = OptionError("flagfile", path, "a directory", "a file path");
     return false;
   }
+  // A pipe read here would be empty for gflags, which reads the file again;
+  // a named one would wait for a writer.
+  if (std::filesystem::is_fifo(path, ec)) {
+    *error = OptionError("flagfile", path, "a pipe", "a file path");
+    return false;
+  }
   std::ifstream in(path);
   if (!in) {
     *error = OptionError("flagfile", path, "cannot open for reading");

@@ -194,11 +194,39 @@ std::string ReplaceAll(std::string text, const std::string& from,
   return text;
 }
 
+namespace {
+
+// A named pipe: opening it to read waits, maybe forever, for a writer. An
+// anonymous one (a shell's <(...), /dev/fd/N, its link "pipe:[inode]")
+// has its writer already and opens at once.
+bool IsNamedPipe(const std::string& path) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (!fs::is_fifo(path, ec)) return false;
+  fs::path at = path;
+  for (int hop = 0; hop < 40 && fs::is_symlink(at, ec); ++hop) {
+    const fs::path target = fs::read_symlink(at, ec);
+    if (ec) break;
+    if (target.string().rfind("pipe:", 0) == 0) return false;
+    at = target.is_absolute() ? target : at.parent_path() / target;
+  }
+  return true;
+}
+
+}  // namespace
+
 bool OpenForReading(const std::string& path, std::ifstream* stream,
                     std::string* error) {
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) {
     *error = path + ": cannot open for reading: is a directory, not a file";
+    return false;
+  }
+  if (IsNamedPipe(path)) {
+    *error = path +
+             ": cannot open for reading: is a named pipe, which may wait "
+             "forever for a writer; give a file, or the pipe as <(cat " +
+             path + ")";
     return false;
   }
   stream->open(path, std::ios::in | std::ios::binary);

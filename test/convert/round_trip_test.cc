@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <iostream>
 #include <map>
 #include <sstream>
@@ -16,6 +17,7 @@
 #include "rff_ceres/convert/pyfg.h"
 #include "rff_ceres/io/dataset_io.h"
 #include "rff_ceres/slam_solver.h"
+#include "test/test_files.h"
 
 namespace rff {
 namespace {
@@ -51,6 +53,36 @@ Dataset ThroughG2o(const Dataset& dataset) {
   EXPECT_TRUE(ParseG2o(&text, "round_trip.g2o", {}, &back, &read, &error))
       << error;
   return back;
+}
+
+// A sigma whose square overflows (PyFG's covariance is inf) or whose
+// information underflows (g2o's is 0) makes a file its own reader refuses:
+// not written, with the reader's words.
+TEST(RoundTripTest, AFileItsReaderWouldRefuseIsNotWritten) {
+  std::istringstream in(
+      "RFFD 1\n"
+      "PRIOR_POSE 0 0 0 0 0.1 0.01\n"
+      "ODOM 0 1 1 0 0 1e200 0.1 0.01\n"
+      "BEARING 1 3 0.5 0.01\n");
+  Dataset d;
+  std::string error;
+  ASSERT_TRUE(ParseDataset(&in, "wide.rffd", &d, &error)) << error;
+  const std::string dir = testing::TempDir("RoundTripTest");
+  const std::string pyfg = dir + "/wide.pyfg", g2o = dir + "/wide.g2o";
+  PyfgWriteSummary pyfg_summary;
+  EXPECT_FALSE(WritePyfg(d, pyfg, &pyfg_summary, &error));
+  EXPECT_EQ(error, pyfg + ": not written: its reader would refuse it: " + pyfg +
+                       ":5: field 8 'inf' is not a finite number");
+  EXPECT_FALSE(std::filesystem::exists(pyfg));
+  G2oWriteSummary g2o_summary;
+  EXPECT_FALSE(WriteG2o(d, g2o, &g2o_summary, &error));
+  EXPECT_EQ(error, g2o + ": not written: its reader would refuse it: " + g2o +
+                       ":6: EDGE_SE2 information entry (1,1) = 0 is not > 0");
+  EXPECT_FALSE(std::filesystem::exists(g2o));
+  // With a sigma both formats carry, both files are written.
+  d.odometry[0].sigma_x = 0.1;
+  EXPECT_TRUE(WritePyfg(d, pyfg, &pyfg_summary, &error)) << error;
+  EXPECT_TRUE(WriteG2o(d, g2o, &g2o_summary, &error)) << error;
 }
 
 // What g2o's 2D types express: pose priors, odometry, bearings and

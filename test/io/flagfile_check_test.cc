@@ -1,5 +1,8 @@
 #include "rff_ceres/io/flagfile_check.h"
 
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <string>
 #include <vector>
 
@@ -53,6 +56,15 @@ TEST(FlagfileCheckTest, SelfInclusionIsAnError) {
             "--flagfile=" + dir +
                 "/a.flags: includes itself through other "
                 "flagfiles");
+}
+
+// Read here, a pipe would reach gflags empty: its flags silently lost.
+TEST(FlagfileCheckTest, APipeIsAnError) {
+  const std::string fifo = TempDir("FlagfileCheckTest") + "/flags.pipe";
+  ::unlink(fifo.c_str());
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  EXPECT_EQ(Check({"--flagfile=" + fifo}),
+            "--flagfile=" + fifo + ": a pipe; allowed a file path");
 }
 
 // gflags would read FLAGS_flagfile from the environment unchecked.

@@ -1,7 +1,11 @@
 #include "rff_ceres/io/text_parser.h"
 
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <cmath>
 #include <cstdlib>
+#include <fstream>
 #include <ios>
 #include <sstream>
 #include <streambuf>
@@ -9,6 +13,7 @@
 #include <vector>
 
 #include "gtest/gtest.h"
+#include "test/test_files.h"
 
 namespace rff {
 namespace {
@@ -135,6 +140,35 @@ TEST(TextParserTest, AFailedReadIsAReadError) {
     EXPECT_EQ(reader.error(),
               good.empty() ? "f.txt:0: read error" : "f.txt:1: read error");
   }
+}
+
+// A named pipe is refused at once (opening it would wait for a writer);
+// an anonymous one, a shell's <(...), is read to its end.
+TEST(TextParserTest, ANamedPipeIsRefusedAnAnonymousOneRead) {
+  const std::string fifo = testing::TempDir("TextParserTest") + "/named.pipe";
+  ::unlink(fifo.c_str());
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  std::ifstream stream;
+  std::string error;
+  EXPECT_FALSE(OpenForReading(fifo, &stream, &error));
+  EXPECT_EQ(error, fifo +
+                       ": cannot open for reading: is a named pipe, which "
+                       "may wait forever for a writer; give a file, or the "
+                       "pipe as <(cat " +
+                       fifo + ")");
+  int ends[2];
+  ASSERT_EQ(::pipe(ends), 0);
+  ASSERT_EQ(::write(ends[1], "a b\n", 4), 4);
+  ::close(ends[1]);
+  const std::string anonymous = "/dev/fd/" + std::to_string(ends[0]);
+  ASSERT_TRUE(OpenForReading(anonymous, &stream, &error)) << error;
+  LineReader reader(&stream, anonymous);
+  std::vector<std::string_view> fields;
+  ASSERT_TRUE(reader.Next(&fields));
+  EXPECT_EQ(fields, (std::vector<std::string_view>{"a", "b"}));
+  EXPECT_FALSE(reader.Next(&fields));
+  EXPECT_TRUE(reader.ok()) << reader.error();
+  ::close(ends[0]);
 }
 
 TEST(TextParserTest, SplitsFieldsSkipsCommentsAndCountsLines) {
