@@ -14,6 +14,9 @@
 
 namespace rff {
 
+// Within this squared distance of the robot a landmark has no bearing.
+inline constexpr double kMinBearingSquaredDistance = 1e-24;
+
 // The bearing and its gradients, shared by BearingCost and RangeBearingCost.
 // Returns false when the landmark sits on the robot (bearing undefined).
 inline bool BearingAndGradient(const Eigen::Vector3d& pose,
@@ -22,7 +25,7 @@ inline bool BearingAndGradient(const Eigen::Vector3d& pose,
                                Eigen::Vector2d* d_landmark) {
   const Eigen::Vector2d d = landmark - pose.head<2>();
   const double q = d.squaredNorm();
-  if (!(q > 1e-24)) return false;
+  if (!(q > kMinBearingSquaredDistance)) return false;
   *bearing = std::atan2(d.y(), d.x()) - pose.z();
   *d_pose << d.y() / q, -d.x() / q, -1.0;
   *d_landmark << -d.y() / q, d.x() / q;

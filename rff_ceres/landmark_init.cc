@@ -1,9 +1,11 @@
 #include "rff_ceres/landmark_init.h"
 
 #include <cmath>
+#include <map>
 #include <vector>
 
 #include "Eigen/Dense"
+#include "costs/bearing_cost.h"
 
 namespace rff {
 namespace {
@@ -92,8 +94,22 @@ bool InitializeLandmarks(const Dataset& dataset, const PoseFunction& pose,
                          std::vector<LandmarkId>* unlocated) {
   landmarks->clear();
   if (unlocated != nullptr) unlocated->clear();
+  std::map<LandmarkId, double> prior_sigma;
   for (const LandmarkPrior& p : dataset.landmark_priors) {
     (*landmarks)[p.id] = Eigen::Vector2d(p.x, p.y);
+    prior_sigma[p.id] = p.sigma;
+  }
+  // A prior mean on a pose that sees the landmark by a bearing leaves that
+  // bearing undefined where the solve starts: it starts one prior sigma
+  // along the bearing instead, where both allow it.
+  for (const Observation& o : dataset.observations) {
+    const auto sigma = prior_sigma.find(o.id);
+    if (!o.HasBearing() || sigma == prior_sigma.end()) continue;
+    const Eigen::Vector3d p = pose(o.t);
+    Eigen::Vector2d& l = (*landmarks)[o.id];
+    if ((l - p.head<2>()).squaredNorm() > kMinBearingSquaredDistance) continue;
+    const double angle = p.z() + o.bearing;
+    l += sigma->second * Eigen::Vector2d(std::cos(angle), std::sin(angle));
   }
   // Observations of each landmark without a prior.
   struct Seen {

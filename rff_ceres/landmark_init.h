@@ -20,10 +20,12 @@ namespace rff {
 using PoseFunction = std::function<Eigen::Vector3d(double t)>;
 
 // Fills `landmarks` with one initial position per landmark that has a prior
-// or an observation. Fails, naming the landmark, when a landmark without a
-// prior cannot be located from its observations (e.g. one range only, or
-// bearings from a single direction). With `unlocated` non-null such
-// landmarks are listed there instead (incremental mode waits for more data).
+// or an observation (a prior mean exactly on a pose the landmark is seen
+// from by a bearing moves one prior sigma along that bearing). Fails, naming
+// the landmark, when a landmark without a prior cannot be located from its
+// observations (e.g. one range only, or bearings from a single direction). With
+// `unlocated` non-null such landmarks are listed there instead (incremental
+// mode waits for more data).
 bool InitializeLandmarks(const Dataset& dataset, const PoseFunction& pose,
                          std::map<LandmarkId, Eigen::Vector2d>* landmarks,
                          std::string* error,

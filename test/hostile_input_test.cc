@@ -129,6 +129,20 @@ const Rejected kRejectedRffd[] = {
     {"LineOneByteTooLong",
      std::string(kHead) + "#" + std::string(kMaxLineLength, 'x') + "\n",
      "h.rffd:3: line longer than 65536 bytes"},
+    // Angles are judged as written: wrapped, 1e300 rad would pass as some
+    // angle in (-pi, pi] that the file never said.
+    {"BearingBeyondDoublePrecision",
+     std::string(kHead) + "RANGE_BEARING 5 1 10 1e300 1 0.03\n",
+     "h.rffd:3: sigma_bearing 0.03 is finer than double precision resolves "
+     "its bearing; allowed at least 2.2204460492503132e+284"},
+    {"HeadingBeyondDoublePrecision",
+     std::string(kHead) + "PRIOR_POSE 1 0 0 1e300 1 0.1\n",
+     "h.rffd:3: sigma_theta 0.1 is finer than double precision resolves its "
+     "heading"},
+    {"OdometryTurnBeyondDoublePrecision",
+     std::string(kHead) + "ODOM 0 1 0 0 -1e300 1 1 0.1\n",
+     "h.rffd:3: sigma_theta 0.1 is finer than double precision resolves its "
+     "dtheta"},
     {"HeaderOnly", "RFFD 1\n", "h.rffd: no PRIOR_POSE record"},
     {"DuplicateGroundTruthTimeOutOfOrder",
      std::string(kHead) + "GT_POSE 2 0 0 0\nGT_POSE 1 0 0 0\nGT_POSE 2 1 0 0\n",
@@ -270,6 +284,32 @@ TEST(HostileRffdAcceptedTest, OdometrySigmaTooLargeIsNamedSo) {
               "odometry from t = 0 to 1: its covariance cannot be inverted "
               "in double precision (sigmas too large)")
         << prior;
+  }
+}
+
+// A landmark prior exactly where the robot starts, seen from there by a
+// bearing: valid data, solved (the start moves off the undefined bearing).
+TEST(HostileRffdAcceptedTest, ALandmarkPriorOnTheStartingPoseIsSolved) {
+  Dataset d;
+  std::string error;
+  ASSERT_TRUE(
+      ParseRffd("RFFD 1\nPRIOR_POSE 0 0 0 0 0.1 0.1\nPRIOR_LANDMARK 1 0 0 1\n"
+                "BEARING 0 1 0 0.01\nBEARING 1 1 1 0.01\n",
+                &d, &error))
+      << error;
+  for (const char* prior : {"rff", "wnoa"}) {
+    SlamOptions options;
+    options.prior = prior;
+    SlamResult result;
+    ASSERT_TRUE(RunSlam(d, options, &result, &error)) << prior << ": " << error;
+    ASSERT_EQ(result.landmarks.size(), 1u);
+    // Ahead of the first pose, along its bearing of 0 (within the heading
+    // prior's 0.1 rad), drawn towards the prior's mean.
+    const Landmark& l = result.landmarks[0];
+    EXPECT_GT(l.x, 0.0) << prior;
+    EXPECT_LT(std::abs(std::atan2(l.y, l.x)), 0.1) << prior;
+    EXPECT_LT(std::hypot(l.x, l.y), 0.5) << prior;
+    EXPECT_EQ(result.quality.verdict, "ok") << prior;
   }
 }
 

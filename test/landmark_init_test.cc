@@ -46,6 +46,28 @@ TEST(LandmarkInitTest, UsesPriorThenRangeBearingThenBearings) {
   EXPECT_NEAR((landmarks[9] - truth).norm(), 0.0, 1e-9);
 }
 
+// A prior mean exactly on a pose that sees the landmark by a bearing (no
+// bearing there) starts one prior sigma along that bearing; a range alone
+// there, or a prior off the robot, leaves the prior mean.
+TEST(LandmarkInitTest, APriorOnTheRobotStartsAlongTheBearing) {
+  Dataset d;
+  d.landmark_priors.push_back({1, 2.0, 0.0, 0.5});  // On the pose at t = 2.
+  d.landmark_priors.push_back({2, 3.0, 0.0, 0.5});  // On the pose at t = 3.
+  d.landmark_priors.push_back({3, 4.0, 1e-6, 0.5});
+  Observation bearing = Make(ObservationType::kBearing, 2, 1, {2.0, 1.0});
+  d.observations.push_back(bearing);
+  d.observations.push_back(Make(ObservationType::kRange, 3, 2, {3.0, 1.0}));
+  d.observations.push_back(Make(ObservationType::kBearing, 4, 3, {4.0, 1.0}));
+  std::map<LandmarkId, Eigen::Vector2d> landmarks;
+  std::string error;
+  ASSERT_TRUE(InitializeLandmarks(d, StraightLine, &landmarks, &error))
+      << error;
+  ASSERT_DOUBLE_EQ(bearing.bearing, M_PI / 2);
+  EXPECT_NEAR((landmarks[1] - Eigen::Vector2d(2.0, 0.5)).norm(), 0.0, 1e-15);
+  EXPECT_EQ(landmarks[2], Eigen::Vector2d(3.0, 0.0));
+  EXPECT_EQ(landmarks[3], Eigen::Vector2d(4.0, 1e-6));
+}
+
 TEST(LandmarkInitTest, RangesFromAStraightLineAreAmbiguous) {
   // The mirror image across the line fits the ranges as well: refuse.
   Dataset d;

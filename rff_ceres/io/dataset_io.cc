@@ -214,9 +214,12 @@ class DatasetParser {
     if (!Positive(v[4], "sigma_xy") || !Positive(v[5], "sigma_theta")) {
       return false;
     }
-    const PosePrior prior{{v[0], v[1], v[2], WrapAngle(v[3])}, v[4], v[5]};
+    // Angles are judged as written, before wrapping: 1e300 rad has no
+    // digits left for any sigma.
+    PosePrior prior{{v[0], v[1], v[2], v[3]}, v[4], v[5]};
     const std::string why = UnresolvedPosePrior(prior);
     if (!why.empty()) return Fail(why);
+    prior.pose.theta = WrapAngle(prior.pose.theta);
     dataset_->pose_priors.push_back(prior);
     return true;
   }
@@ -255,10 +258,10 @@ class DatasetParser {
         !Positive(v[7], "sigma_theta")) {
       return false;
     }
-    const Odometry odometry{v[0], v[1], v[2], v[3], WrapAngle(v[4]),
-                            v[5], v[6], v[7]};
+    Odometry odometry{v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7]};
     const std::string why = UnresolvedOdometry(odometry);
     if (!why.empty()) return Fail(why);
+    odometry.dtheta = WrapAngle(odometry.dtheta);
     dataset_->odometry.push_back(odometry);
     return true;
   }
@@ -278,7 +281,7 @@ class DatasetParser {
       ++field;
     }
     if (type.bearing) {
-      obs.bearing = WrapAngle(v[field]);
+      obs.bearing = v[field];
       obs.sigma_bearing = v[field + measured];
     }
     // A noisy range may be negative (a Gaussian measurement of a short
@@ -291,6 +294,7 @@ class DatasetParser {
     }
     const std::string why = UnresolvedObservation(obs);
     if (!why.empty()) return Fail(why);
+    if (obs.HasBearing()) obs.bearing = WrapAngle(obs.bearing);
     dataset_->observations.push_back(obs);
     return true;
   }
