@@ -388,7 +388,9 @@ const std::vector<FeatureTrajectory::Features>& FeatureTrajectory::FeaturesAt(
 PoseMap FeatureTrajectory::PoseAt(double t) const {
   PoseMap map;
   map.mean = mean_->Evaluate(t);
-  for (const Features& f : FeaturesAt(t)) {
+  const std::vector<Features>& features = FeaturesAt(t);
+  map.terms.reserve(3 * features.size());  // One allocation, not three.
+  for (const Features& f : features) {
     map.terms.push_back({3 * f.segment + kX, 0, f.position});
     map.terms.push_back({3 * f.segment + kY, 1, f.position});
     map.terms.push_back({3 * f.segment + kTheta, 2, f.heading});

@@ -226,6 +226,7 @@ PoseMap WnoaTrajectory::PoseAt(double t) const {
   PoseMap map;
   map.mean = mean_->Evaluate(t);
   const Interpolation& interpolation = InterpolationAt(t);
+  map.terms.reserve(3 * interpolation.num_blocks);  // One allocation.
   for (int k = 0; k < interpolation.num_blocks; ++k) {
     for (int c = 0; c < 3; ++c) {
       map.terms.push_back(
