@@ -171,7 +171,7 @@ int main(int argc, char** argv) {
     }
     // Every flagfile starts from the command line's flags; the saver puts
     // them back afterwards. Not fatal: a bad file is a failed row.
-    if (!rff::CheckFlagfiles({"--flagfile=" + path}, rff::IsKnownToolFlag,
+    if (!rff::CheckFlagfiles({"--flagfile=" + path}, rff::ToolFlagKind,
                              message)) {
       return false;
     }

@@ -8,12 +8,17 @@
 
 namespace rff {
 
-bool IsKnownToolFlag(const std::string& name) {
+FlagKind ToolFlagKind(const std::string& name) {
   gflags::CommandLineFlagInfo info;
-  if (gflags::GetCommandLineFlagInfo(name.c_str(), &info)) return true;
+  if (gflags::GetCommandLineFlagInfo(name.c_str(), &info)) {
+    return info.type == "bool" ? FlagKind::kBoolean : FlagKind::kValued;
+  }
   return name.rfind("no", 0) == 0 &&
-         gflags::GetCommandLineFlagInfo(name.substr(2).c_str(), &info) &&
-         info.type == "bool";
+                 gflags::GetCommandLineFlagInfo(name.substr(2).c_str(),
+                                                &info) &&
+                 info.type == "bool"
+             ? FlagKind::kBoolean
+             : FlagKind::kUnknown;
 }
 
 namespace {
@@ -33,8 +38,7 @@ std::vector<NamedPath> WithFlagfiles(std::vector<NamedPath> inputs) {
 bool ParseToolFlags(int* argc, char*** argv, std::string* error) {
   std::signal(SIGXFSZ, SIG_IGN);
   const std::vector<std::string> args(*argv + 1, *argv + *argc);
-  if (!CheckFlagfiles(args, IsKnownToolFlag, error, nullptr,
-                      &FlagfilesRead())) {
+  if (!CheckFlagfiles(args, ToolFlagKind, error, nullptr, &FlagfilesRead())) {
     return false;
   }
   gflags::ParseCommandLineFlags(argc, argv, true);

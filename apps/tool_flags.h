@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "rff_ceres/io/flagfile_check.h"
 #include "rff_ceres/io/output_file.h"
 
 namespace rff {
@@ -21,8 +22,8 @@ bool ParseToolFlags(int* argc, char*** argv, std::string* error);
 // output never overwrites the flags it was given by.
 std::vector<NamedPath> WithFlagfiles(std::vector<NamedPath> inputs);
 
-// Whether the tool defines a flag of this name ("noname" for a boolean).
-bool IsKnownToolFlag(const std::string& name);
+// What the tool's flag of this name is ("noname" for a boolean's negation).
+FlagKind ToolFlagKind(const std::string& name);
 
 }  // namespace rff
 

@@ -68,8 +68,22 @@ const std::map<std::string, std::string>& ToolFlags() {
 }
 
 std::string PathOf(py::handle path) {
-  // str, bytes or os.PathLike, as open() takes them (TypeError otherwise).
-  return py::str(py::module_::import("os").attr("fsdecode")(path));
+  // str, bytes or os.PathLike, as open() takes them (TypeError otherwise),
+  // as the bytes the system sees (a name that is no UTF-8 too).
+  const std::string bytes =
+      py::bytes(py::module_::import("os").attr("fsencode")(path));
+  // As open(): the C library would stop at a NUL and read another file.
+  if (bytes.find('\0') != std::string::npos) {
+    throw py::value_error("embedded null byte in path");
+  }
+  if (bytes.empty()) throw py::value_error("empty path");
+  return bytes;
+}
+
+// Text of a file (a path, a comment) for Python: undecodable bytes as
+// os.fsdecode gives them back, never an error on reading an attribute.
+py::str TextOf(const std::string& bytes) {
+  return py::module_::import("os").attr("fsdecode")(py::bytes(bytes));
 }
 
 Array Zeros(std::vector<py::ssize_t> shape) {
@@ -146,7 +160,14 @@ std::string OptionText(const std::string& name, py::handle value) {
   if (py::isinstance<py::bool_>(v)) return v.cast<bool>() ? "true" : "false";
   if (py::isinstance<py::int_>(v)) return py::str(v);
   if (py::isinstance<py::float_>(v)) return py::repr(v);  // Round-trips.
-  if (py::isinstance<py::str>(v)) return v.cast<std::string>();
+  if (py::isinstance<py::str>(v)) {
+    const std::string text = v.cast<std::string>();
+    // gflags would read the value up to the NUL.
+    if (text.find('\0') != std::string::npos) {
+      throw py::value_error("option '" + name + "' holds a NUL character");
+    }
+    return text;
+  }
   if (name == "flagfile" && py::hasattr(v, "__fspath__")) return PathOf(v);
   throw py::value_error("option '" + name +
                         "' must be a bool, int, float or str, got " +
@@ -169,6 +190,9 @@ PyResult Solve(py::handle dataset_or_path, const py::kwargs& kwargs) {
   std::string error;
   for (const auto& [key, value] : kwargs) {
     const std::string name = py::str(key);
+    if (name.find('\0') != std::string::npos) {
+      throw py::value_error("an option name holds a NUL character");
+    }
     if (name == "compute_covariance") {
       compute_covariance = BoolOption(name, value);
     } else if (name == "verbose") {
@@ -326,7 +350,8 @@ void Save(const PyResult& result, const std::string& path,
 }
 
 py::dict EvaluatePy(py::handle dataset_or_path, const PyResult& result,
-                    bool align) {
+                    py::handle align_option) {
+  const bool align = BoolOption("align", align_option);
   const PyDataset dataset = DatasetOf(dataset_or_path);
   const Dataset& data = *dataset.data;
   const std::string prefix = dataset.path.empty() ? "" : dataset.path + ": ";
@@ -427,7 +452,7 @@ PYBIND11_MODULE(rffslam, m) {
           "path",
           [](const PyDataset& d) -> py::object {
             if (d.path.empty()) return py::none();
-            return py::str(d.path);
+            return rff::TextOf(d.path);
           },
           "The file it was read from.")
       .def_property_readonly(
@@ -435,7 +460,7 @@ PYBIND11_MODULE(rffslam, m) {
           [](const PyDataset& d) {
             py::dict metadata;
             for (const auto& [key, value] : d.data->metadata) {
-              metadata[py::str(key)] = value;
+              metadata[rff::TextOf(key)] = rff::TextOf(value);
             }
             return metadata;
           },
@@ -608,7 +633,7 @@ PYBIND11_MODULE(rffslam, m) {
         "RuntimeError. The GIL is released during the solve, and\nCtrl-C "
         "stops it with KeyboardInterrupt.");
   m.def("evaluate", &rff::EvaluatePy, py::arg("dataset_or_path"),
-        py::arg("result"), py::arg("align") = false,
+        py::arg("result"), py::arg("align") = py::bool_(false),
         "Errors of `result` against the dataset's ground truth: the dict of "
         "rff_evaluate\n--json with the trajectory and landmarks (and "
         "covariances, when computed) of\n`result`, without its input file "

@@ -65,8 +65,14 @@ bool SlamOptionsFromSettings(const std::vector<Setting>& settings,
   // Every call starts from the flags as they are (their defaults) and leaves
   // them so.
   gflags::FlagSaver saver;
-  const FlagIsKnown known = [](const std::string& name) {
-    return IsSlamFlag(name) || IsNegatedSlamFlag(name);
+  const FlagKindOf kind_of = [](const std::string& name) {
+    if (IsNegatedSlamFlag(name)) return FlagKind::kBoolean;
+    gflags::CommandLineFlagInfo info;
+    if (!IsSlamFlag(name) ||
+        !gflags::GetCommandLineFlagInfo(name.c_str(), &info)) {
+      return FlagKind::kUnknown;
+    }
+    return info.type == "bool" ? FlagKind::kBoolean : FlagKind::kValued;
   };
   // gflags parses each line as it would in the file, alone so that a bad
   // value is named with its line.
@@ -79,7 +85,7 @@ bool SlamOptionsFromSettings(const std::vector<Setting>& settings,
   };
   for (const auto& [name, value] : settings) {
     if (name != "flagfile") continue;
-    if (!CheckFlagfiles({"--flagfile=" + value}, known, error, apply)) {
+    if (!CheckFlagfiles({"--flagfile=" + value}, kind_of, error, apply)) {
       return false;
     }
   }

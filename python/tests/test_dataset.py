@@ -98,3 +98,21 @@ def test_the_module_is_the_one_built_here():
         module = pathlib.Path(rffslam.__file__).resolve()
         assert module.parent == pathlib.Path(binary_dir).resolve() / "python"
     assert rffslam.__version__
+
+
+def test_a_nul_or_empty_path_is_refused_not_cut_short():
+    # open() refuses both; the C library would read the file before the NUL.
+    for bad in (str(PLAZA) + "\0garbage", bytes(PLAZA) + b"\0x", ""):
+        with pytest.raises(ValueError, match="embedded null byte|empty path"):
+            rffslam.read_dataset(bad)
+    with pytest.raises(ValueError, match="embedded null byte"):
+        rffslam.solve(str(PLAZA) + "\0garbage")
+
+
+def test_names_and_comments_that_are_no_utf8_are_read(tmp_path):
+    path = os.fsencode(tmp_path) + b"/\xff.rffd"
+    with open(path, "wb") as f:
+        f.write(b"# key: \xfe\xff\nRFFD 1\nPRIOR_POSE 0 0 0 0 0.1 0.1\n")
+    dataset = rffslam.read_dataset(path)
+    assert os.fsencode(dataset.path) == path
+    assert os.fsencode(dataset.metadata["key"]) == b"\xfe\xff"

@@ -288,6 +288,23 @@ def test_evaluate_errors(solved, tmp_path):
         rffslam.evaluate(far, "not a result")
 
 
+def test_align_is_true_or_false(small, solved):
+    for bad in (None, 1, "yes"):
+        with pytest.raises(ValueError, match="'align' must be True or False"):
+            rffslam.evaluate(small, solved, align=bad)
+
+
+def test_a_nul_in_an_option_or_an_empty_flagfile_is_refused(small):
+    # gflags would read each up to the NUL, or skip the empty name.
+    with pytest.raises(ValueError, match="option 'prior' holds a NUL"):
+        rffslam.solve(small, prior="wnoa\0zzz")
+    with pytest.raises(ValueError, match="an option name holds a NUL"):
+        rffslam.solve(small, **{"prior\0zzz": "wnoa"})
+    for empty in ("", ","):
+        with pytest.raises(ValueError, match="an empty file name"):
+            rffslam.solve(small, flagfile=empty)
+
+
 def test_a_failed_solve_is_a_runtime_error(tmp_path):
     empty = tmp_path / "empty.rffd"
     empty.write_text("RFFD 1\nPRIOR_POSE 0 0 0 0 0.1 0.1\n")

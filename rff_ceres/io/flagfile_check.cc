@@ -62,7 +62,7 @@ bool CheckFromEnvironment(const std::string& name, const std::string& value,
   return true;
 }
 
-bool CheckFlagfile(const std::string& path, const FlagIsKnown& is_known,
+bool CheckFlagfile(const std::string& path, const FlagKindOf& kind_of,
                    const FlagLineVisitor& on_flag,
                    std::vector<std::string>* open,
                    std::vector<std::string>* read, std::string* error) {
@@ -88,10 +88,13 @@ bool CheckFlagfile(const std::string& path, const FlagIsKnown& is_known,
     *error = OptionError("flagfile", path, "a directory", "a file path");
     return false;
   }
-  // A pipe read here would be empty for gflags, which reads the file again;
-  // a named one would wait for a writer.
-  if (std::filesystem::is_fifo(path, ec)) {
-    *error = OptionError("flagfile", path, "a pipe", "a file path");
+  // A pipe read here would be empty for gflags, which reads the file again
+  // (a named one waits for a writer); a device may never end (/dev/zero).
+  if (std::filesystem::exists(path, ec) &&
+      !std::filesystem::is_regular_file(path, ec)) {
+    *error = OptionError("flagfile", path,
+                         "not a regular file (a device, pipe or socket)",
+                         "a file path");
     return false;
   }
   std::ifstream in(path);
@@ -118,12 +121,16 @@ bool CheckFlagfile(const std::string& path, const FlagIsKnown& is_known,
     }
     if (name == "flagfile") {
       for (const std::string& nested : SplitCommas(FlagValue(text))) {
-        if (!CheckFlagfile(nested, is_known, on_flag, open, read, error)) {
+        if (!CheckFlagfile(nested, kind_of, on_flag, open, read, error)) {
           return false;
         }
       }
-    } else if (!is_known(name)) {
+    } else if (kind_of(name) == FlagKind::kUnknown) {
       *error = where + "unknown flag '--" + name + "'";
+      return false;
+    } else if (kind_of(name) == FlagKind::kValued &&
+               text.find('=') == std::string::npos) {
+      *error = where + "'--" + name + "' needs a value: --" + name + "=VALUE";
       return false;
     } else if (on_flag && !on_flag(where, line, error)) {
       return false;
@@ -136,7 +143,7 @@ bool CheckFlagfile(const std::string& path, const FlagIsKnown& is_known,
 }  // namespace
 
 bool CheckFlagfiles(const std::vector<std::string>& args,
-                    const FlagIsKnown& is_known, std::string* error,
+                    const FlagKindOf& kind_of, std::string* error,
                     const FlagLineVisitor& on_flag,
                     std::vector<std::string>* read) {
   for (std::size_t i = 0; i < args.size(); ++i) {
@@ -151,9 +158,16 @@ bool CheckFlagfiles(const std::vector<std::string>& args,
     }
     if (!CheckFromEnvironment(name, list, error)) return false;
     if (name != "flagfile") continue;
+    // gflags skips an empty name: a flagfile the user meant would be lost.
+    if (SplitCommas(list).empty() || list.find(",,") != std::string::npos ||
+        list.front() == ',' || list.back() == ',') {
+      *error = OptionError("flagfile", list, "an empty file name",
+                           "comma-separated file paths");
+      return false;
+    }
     for (const std::string& path : SplitCommas(list)) {
       std::vector<std::string> open;
-      if (!CheckFlagfile(path, is_known, on_flag, &open, read, error)) {
+      if (!CheckFlagfile(path, kind_of, on_flag, &open, read, error)) {
         return false;
       }
     }

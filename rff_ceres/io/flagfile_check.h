@@ -11,9 +11,10 @@
 
 namespace rff {
 
-// Whether a flag of this name (without dashes) exists; for a boolean flag
-// "name" both "name" and "noname" are known.
-using FlagIsKnown = std::function<bool(const std::string& name)>;
+// What a flag of this name (without dashes) is: none, a boolean (for a
+// boolean "name" both "name" and "noname"), or one that needs a value.
+enum class FlagKind { kUnknown, kBoolean, kValued };
+using FlagKindOf = std::function<FlagKind(const std::string& name)>;
 
 // Given each flag line that passed the check, in the order gflags applies
 // them (a nested flagfile's lines where it is named): `where` is
@@ -24,13 +25,14 @@ using FlagLineVisitor = std::function<bool(
 
 // Checks every flagfile named in `args` (--flagfile=A,B or --flagfile A)
 // and in the flagfiles they name: each can be read, none includes itself
-// directly or through others, and every line is blank, a '#' comment or
-// --name[=value] with a known name. `error` names the file and line.
+// directly or through others, and every line is blank, a '#' comment,
+// --name=value with a known name or --name of a boolean (gflags would drop
+// a valued flag's line without its value). `error` names the file and line.
 // `on_flag`, when given, sees every flag line as it is checked; `read`, when
 // given, gains the path of every flagfile read (inputs no output may
 // overwrite).
 bool CheckFlagfiles(const std::vector<std::string>& args,
-                    const FlagIsKnown& is_known, std::string* error,
+                    const FlagKindOf& kind_of, std::string* error,
                     const FlagLineVisitor& on_flag = nullptr,
                     std::vector<std::string>* read = nullptr);
 

@@ -15,14 +15,15 @@ namespace {
 using testing::TempDir;
 using testing::WriteFile;
 
-bool Known(const std::string& name) {
-  return name == "num_features" || name == "prior" || name == "evaluate" ||
-         name == "noevaluate";
+FlagKind Kind(const std::string& name) {
+  if (name == "num_features" || name == "prior") return FlagKind::kValued;
+  if (name == "evaluate" || name == "noevaluate") return FlagKind::kBoolean;
+  return FlagKind::kUnknown;
 }
 
 std::string Check(const std::vector<std::string>& args) {
   std::string error;
-  return CheckFlagfiles(args, Known, &error) ? "ok" : error;
+  return CheckFlagfiles(args, Kind, &error) ? "ok" : error;
 }
 
 TEST(FlagfileCheckTest, AcceptsCommentsBlanksAndKnownFlags) {
@@ -58,13 +59,29 @@ TEST(FlagfileCheckTest, SelfInclusionIsAnError) {
                 "flagfiles");
 }
 
-// Read here, a pipe would reach gflags empty: its flags silently lost.
-TEST(FlagfileCheckTest, APipeIsAnError) {
+// Read here, a pipe would reach gflags empty (its flags silently lost); a
+// device may never end.
+TEST(FlagfileCheckTest, APipeOrADeviceIsAnError) {
   const std::string fifo = TempDir("FlagfileCheckTest") + "/flags.pipe";
   ::unlink(fifo.c_str());
   ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
   EXPECT_EQ(Check({"--flagfile=" + fifo}),
-            "--flagfile=" + fifo + ": a pipe; allowed a file path");
+            "--flagfile=" + fifo +
+                ": not a regular file (a device, pipe or socket); allowed a "
+                "file path");
+  EXPECT_EQ(Check({"--flagfile=/dev/zero"}),
+            "--flagfile=/dev/zero: not a regular file (a device, pipe or "
+            "socket); allowed a file path");
+}
+
+// gflags drops a valued flag's line without its value; a boolean needs none.
+TEST(FlagfileCheckTest, AValuedFlagWithoutItsValueIsAnError) {
+  const std::string dir = TempDir("FlagfileCheckTest");
+  WriteFile(dir + "/bare.flags", "--evaluate\n--noevaluate\n--prior\n");
+  EXPECT_EQ(Check({"--flagfile=" + dir + "/bare.flags"}),
+            dir + "/bare.flags:3: '--prior' needs a value: --prior=VALUE");
+  WriteFile(dir + "/empty.flags", "--prior=\n");
+  EXPECT_EQ(Check({"--flagfile=" + dir + "/empty.flags"}), "ok");
 }
 
 // gflags would read FLAGS_flagfile from the environment unchecked.
@@ -106,7 +123,7 @@ TEST(FlagfileCheckTest, TheVisitorSeesEveryFlagLineInGflagsOrder) {
         return true;
       };
   std::string error;
-  ASSERT_TRUE(CheckFlagfiles({"--flagfile=" + dir + "/outer.flags"}, Known,
+  ASSERT_TRUE(CheckFlagfiles({"--flagfile=" + dir + "/outer.flags"}, Kind,
                              &error, record))
       << error;
   EXPECT_EQ(seen,
@@ -120,7 +137,7 @@ TEST(FlagfileCheckTest, TheVisitorSeesEveryFlagLineInGflagsOrder) {
     *error = where + "refused '" + line + "'";
     return false;
   };
-  EXPECT_FALSE(CheckFlagfiles({"--flagfile=" + dir + "/outer.flags"}, Known,
+  EXPECT_FALSE(CheckFlagfiles({"--flagfile=" + dir + "/outer.flags"}, Kind,
                               &error, refuse));
   EXPECT_EQ(error, dir + "/outer.flags:2: refused '  --prior=wnoa'");
 }
