@@ -152,11 +152,22 @@ PyDataset DatasetOf(py::handle dataset_or_path) {
   return ReadPyDataset(PathOf(dataset_or_path));
 }
 
+// numpy scalars and 0-d arrays as the Python values they hold; a larger
+// array is no option value.
+py::object SingleValue(const std::string& name, py::object v) {
+  if (!py::hasattr(v, "dtype") || !py::hasattr(v, "item")) return v;
+  if (py::hasattr(v, "ndim") && v.attr("ndim").cast<int>() != 0) {
+    throw py::value_error("option '" + name +
+                          "' must be a single value, got an array of shape " +
+                          std::string(py::str(v.attr("shape"))));
+  }
+  return v.attr("item")();
+}
+
 // A keyword's value as rff_slam's command line would spell it.
 std::string OptionText(const std::string& name, py::handle value) {
-  py::object v = py::reinterpret_borrow<py::object>(value);
-  // numpy scalars and 0-d arrays as the Python numbers they hold.
-  if (py::hasattr(v, "dtype") && py::hasattr(v, "item")) v = v.attr("item")();
+  const py::object v =
+      SingleValue(name, py::reinterpret_borrow<py::object>(value));
   if (py::isinstance<py::bool_>(v)) return v.cast<bool>() ? "true" : "false";
   if (py::isinstance<py::int_>(v)) return py::str(v);
   if (py::isinstance<py::float_>(v)) return py::repr(v);  // Round-trips.
@@ -175,8 +186,8 @@ std::string OptionText(const std::string& name, py::handle value) {
 }
 
 bool BoolOption(const std::string& name, py::handle value) {
-  py::object v = py::reinterpret_borrow<py::object>(value);
-  if (py::hasattr(v, "dtype") && py::hasattr(v, "item")) v = v.attr("item")();
+  const py::object v =
+      SingleValue(name, py::reinterpret_borrow<py::object>(value));
   if (!py::isinstance<py::bool_>(v)) {
     throw py::value_error("option '" + name + "' must be True or False");
   }
@@ -277,8 +288,17 @@ PyResult Solve(py::handle dataset_or_path, const py::kwargs& kwargs) {
 
 // Query times: a number (scalar = true) or a 1-D array of finite numbers.
 std::vector<double> QueryTimes(py::handle t, bool* scalar) {
+  // Real numbers only: a cast would read '0.5', True, 1+2j or a datetime.
+  const py::array given = py::module_::import("numpy").attr("asarray")(t);
+  const char kind = given.dtype().kind();
+  if (kind != 'i' && kind != 'u' && kind != 'f') {
+    throw py::value_error("times must be real numbers, got " +
+                          std::string(py::str(given.dtype().attr("name"))) +
+                          " values");
+  }
   const auto array =
-      py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(t);
+      py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(
+          given);
   if (!array || array.ndim() > 1) {
     throw py::value_error("times must be a number or a 1-D array of numbers");
   }

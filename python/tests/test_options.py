@@ -3,6 +3,7 @@ simulated run: each bad input raises, and the interpreter carries on."""
 
 import concurrent.futures
 import math
+import re
 
 import numpy as np
 import pytest
@@ -233,8 +234,7 @@ def test_covariance_needs_compute_covariance(plain, tmp_path):
     ([0.0, 1e9], "1 of 2 query times"),
     (float("nan"), "finite"),
     ([[0.0, 1.0]], "1-D array"),
-    ("soon", "number"),
-    (None, "finite"),
+    ("soon", "real numbers, got str128"),
 ])
 def test_bad_query_times_raise(solved, t, message):
     for query in (solved.pose_at, solved.pose_covariance_at):
@@ -303,6 +303,24 @@ def test_a_nul_in_an_option_or_an_empty_flagfile_is_refused(small):
     for empty in ("", ","):
         with pytest.raises(ValueError, match="an empty file name"):
             rffslam.solve(small, flagfile=empty)
+
+
+def test_an_array_is_no_option_value(small):
+    with pytest.raises(ValueError, match="'num_features' must be a single "
+                                         r"value, got an array of shape \(1, 1\)"):
+        rffslam.solve(small, num_features=np.array([[6]]))
+    with pytest.raises(ValueError, match="'verbose' must be a single value"):
+        rffslam.solve(small, verbose=np.array([True]))
+
+
+@pytest.mark.parametrize("t, name", [
+    ("0.5", "str96"), (True, "bool"), (np.array([0.5 + 7j]), "complex128"),
+    (np.datetime64(1, "s"), "datetime64[s]"), (None, "object"),
+])
+def test_query_times_must_be_real_numbers(solved, t, name):
+    with pytest.raises(ValueError, match=f"times must be real numbers, got "
+                                         f"{re.escape(name)} values"):
+        solved.pose_at(t)
 
 
 def test_a_failed_solve_is_a_runtime_error(tmp_path):
