@@ -37,6 +37,13 @@ std::vector<std::string> SplitCommas(const std::string& list) {
   return items;
 }
 
+// A --flagfile list with an empty name: gflags skips it, and the file the
+// user meant would be lost.
+bool HasEmptyName(const std::string& list) {
+  return SplitCommas(list).empty() || list.find(",,") != std::string::npos ||
+         list.front() == ',' || list.back() == ',';
+}
+
 std::string Trim(const std::string& text) {
   const char* blanks = " \t\r\n";
   const std::size_t begin = text.find_first_not_of(blanks);
@@ -120,6 +127,12 @@ bool CheckFlagfile(const std::string& path, const FlagKindOf& kind_of,
       return false;
     }
     if (name == "flagfile") {
+      if (HasEmptyName(FlagValue(text))) {
+        *error = where + OptionError("flagfile", FlagValue(text),
+                                     "an empty file name",
+                                     "comma-separated file paths");
+        return false;
+      }
       for (const std::string& nested : SplitCommas(FlagValue(text))) {
         if (!CheckFlagfile(nested, kind_of, on_flag, open, read, error)) {
           return false;
@@ -158,9 +171,7 @@ bool CheckFlagfiles(const std::vector<std::string>& args,
     }
     if (!CheckFromEnvironment(name, list, error)) return false;
     if (name != "flagfile") continue;
-    // gflags skips an empty name: a flagfile the user meant would be lost.
-    if (SplitCommas(list).empty() || list.find(",,") != std::string::npos ||
-        list.front() == ',' || list.back() == ',') {
+    if (HasEmptyName(list)) {
       *error = OptionError("flagfile", list, "an empty file name",
                            "comma-separated file paths");
       return false;

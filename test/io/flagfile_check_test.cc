@@ -74,6 +74,24 @@ TEST(FlagfileCheckTest, APipeOrADeviceIsAnError) {
             "socket); allowed a file path");
 }
 
+// gflags skips an empty flagfile name, on the command line or inside.
+TEST(FlagfileCheckTest, AnEmptyFlagfileNameIsAnError) {
+  EXPECT_EQ(Check({"--flagfile="}),
+            "--flagfile=: an empty file name; allowed comma-separated file "
+            "paths");
+  const std::string dir = TempDir("FlagfileCheckTest");
+  WriteFile(dir + "/a.flags", "--prior=rff\n");
+  EXPECT_EQ(Check({"--flagfile=" + dir + "/a.flags,"}),
+            "--flagfile=" + dir +
+                "/a.flags,: an empty file name; allowed comma-separated file "
+                "paths");
+  WriteFile(dir + "/outer.flags", "--flagfile=\n");
+  EXPECT_EQ(Check({"--flagfile=" + dir + "/outer.flags"}),
+            dir +
+                "/outer.flags:1: --flagfile=: an empty file name; allowed "
+                "comma-separated file paths");
+}
+
 // gflags drops a valued flag's line without its value; a boolean needs none.
 TEST(FlagfileCheckTest, AValuedFlagWithoutItsValueIsAnError) {
   const std::string dir = TempDir("FlagfileCheckTest");
