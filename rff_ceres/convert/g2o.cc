@@ -392,6 +392,12 @@ bool WriteG2o(const Dataset& input, std::ostream* output,
       landmarks[p.id] = {p.x, p.y};
     }
   }
+  // The largest id is compared before the + 1 that would overflow it.
+  if (!landmarks.empty() && landmarks.rbegin()->first > INT_MAX) {
+    *error = "landmark id " + std::to_string(landmarks.rbegin()->first) +
+             " does not fit g2o's vertex ids (int)";
+    return false;
+  }
   const LandmarkId pose_base =
       landmarks.empty() ? 0 : landmarks.rbegin()->first + 1;
   if (pose_base > INT_MAX - static_cast<LandmarkId>(times.size())) {

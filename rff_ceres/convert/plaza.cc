@@ -533,6 +533,14 @@ bool CheckPlazaOptions(const PlazaOptions& o, std::string* error) {
                          "a file prefix such as Plaza1");
     return false;
   }
+  // A path here would read files outside --input, which the output check
+  // does not see: it could overwrite one of them.
+  if (o.name.find('/') != std::string::npos) {
+    *error = OptionError("plaza_name", o.name, "holds a '/'",
+                         "a file prefix such as Plaza1 (the directory goes "
+                         "in --input)");
+    return false;
+  }
   if (o.heading_offset && !std::isfinite(*o.heading_offset)) {
     *error =
         OptionError("plaza_heading_offset", FormatNumber(*o.heading_offset), "",

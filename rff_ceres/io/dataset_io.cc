@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <initializer_list>
 #include <limits>
 #include <map>
 #include <set>
@@ -116,6 +117,48 @@ std::string FirstUnresolvedSigma(const Dataset& dataset) {
       return std::string(MeasurementTypeOf(o.type).record) +
              " at t = " + FormatNumber(o.t) + ": " + why;
     }
+  }
+  return "";
+}
+
+// The first record holding a number that is not finite (a converter's sigma
+// scaled past the largest double), as "RECORD at t = T"; empty when there is
+// none. The reader refuses such a file.
+std::string FirstNonFinite(const Dataset& dataset) {
+  auto finite = [](std::initializer_list<double> values) {
+    return std::all_of(values.begin(), values.end(),
+                       [](double v) { return std::isfinite(v); });
+  };
+  for (const PosePrior& p : dataset.pose_priors) {
+    if (!finite({p.pose.t, p.pose.x, p.pose.y, p.pose.theta, p.sigma_xy,
+                 p.sigma_theta})) {
+      return "PRIOR_POSE at t = " + FormatNumber(p.pose.t);
+    }
+  }
+  for (const LandmarkPrior& p : dataset.landmark_priors) {
+    if (!finite({p.x, p.y, p.sigma})) {
+      return "PRIOR_LANDMARK " + std::to_string(p.id);
+    }
+  }
+  for (const Odometry& o : dataset.odometry) {
+    if (!finite({o.t0, o.t1, o.dx, o.dy, o.dtheta, o.sigma_x, o.sigma_y,
+                 o.sigma_theta})) {
+      return "ODOM at t = " + FormatNumber(o.t0);
+    }
+  }
+  for (const Observation& o : dataset.observations) {
+    if (!finite({o.t, o.range, o.bearing, o.sigma_range, o.sigma_bearing})) {
+      return std::string(MeasurementTypeOf(o.type).record) +
+             " at t = " + FormatNumber(o.t);
+    }
+  }
+  for (const TimedPose& p : dataset.ground_truth) {
+    if (!finite({p.t, p.x, p.y, p.theta})) {
+      return "GT_POSE at t = " + FormatNumber(p.t);
+    }
+  }
+  for (const Landmark& l : dataset.ground_truth_landmarks) {
+    if (!finite({l.x, l.y})) return "GT_LANDMARK " + std::to_string(l.id);
   }
   return "";
 }
@@ -454,7 +497,15 @@ void WriteDataset(const Dataset& dataset, std::ostream* output) {
 
 bool WriteDataset(const Dataset& dataset, const std::string& path,
                   std::string* error) {
-  // Never a file the reader refuses (a simulator's sigma given too fine).
+  // Never a file the reader refuses: a number scaled past the largest
+  // double, or a simulator's sigma given too fine.
+  const std::string non_finite = FirstNonFinite(dataset);
+  if (!non_finite.empty()) {
+    *error = path + ": not written: " + non_finite +
+             " holds a number that is not finite (the reader would refuse the "
+             "file)";
+    return false;
+  }
   const std::string unresolved = FirstUnresolvedSigma(dataset);
   if (!unresolved.empty()) {
     *error = path + ": not written: " + unresolved +

@@ -1,5 +1,6 @@
 #include "rff_ceres/convert/g2o.h"
 
+#include <limits>
 #include <sstream>
 #include <string>
 
@@ -207,6 +208,13 @@ TEST(G2oWriteTest, IdsBeyondG2oIntAreRefused) {
   EXPECT_FALSE(WriteG2o(d, &out, &s, &error));
   EXPECT_EQ(error,
             "landmark id 2147483647 and 1 poses do not fit g2o's vertex ids "
+            "(int)");
+  EXPECT_EQ(out.str(), "");
+  // The largest id of all, where adding the poses would overflow first.
+  d.observations[0].id = std::numeric_limits<LandmarkId>::max();
+  EXPECT_FALSE(WriteG2o(d, &out, &s, &error));
+  EXPECT_EQ(error,
+            "landmark id 9223372036854775807 does not fit g2o's vertex ids "
             "(int)");
   EXPECT_EQ(out.str(), "");
 }

@@ -309,6 +309,12 @@ TEST(PlazaConvertTest, RejectsBadOptions) {
   EXPECT_FALSE(ConvertPlaza("/nonexistent", options, &d, &s, &error));
   EXPECT_EQ(error,
             "--plaza_name=: empty; allowed a file prefix such as Plaza1");
+  // A path would read files the output check does not see.
+  options.name = "../other/Plaza1";
+  EXPECT_FALSE(ConvertPlaza("/nonexistent", options, &d, &s, &error));
+  EXPECT_EQ(error,
+            "--plaza_name=../other/Plaza1: holds a '/'; allowed a file prefix "
+            "such as Plaza1 (the directory goes in --input)");
 }
 
 // A raw Plaza recording whose odometry frame is the GT heading frame turned

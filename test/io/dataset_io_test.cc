@@ -2,10 +2,12 @@
 
 #include <cmath>
 #include <filesystem>
+#include <limits>
 #include <sstream>
 
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
+#include "rff_ceres/io/text_parser.h"
 #include "test/test_files.h"
 
 namespace rff {
@@ -222,6 +224,17 @@ TEST(DatasetIoTest, WriterRefusesWhatTheReaderWould) {
                        "resolves its range; allowed at least "
                        "6.661338147750939e-16 (the reader would refuse the "
                        "file)");
+  EXPECT_FALSE(std::filesystem::exists(path));
+  // A sigma scaled past the largest double (a converter's per-metre sigma
+  // of 1e308) is no number the reader takes.
+  ASSERT_TRUE(Parse(kValid, &d, &error)) << error;
+  ASSERT_FALSE(d.odometry.empty());
+  d.odometry.back().sigma_x = std::numeric_limits<double>::infinity();
+  EXPECT_FALSE(WriteDataset(d, path, &error));
+  EXPECT_EQ(error, path + ": not written: ODOM at t = " +
+                       FormatNumber(d.odometry.back().t0) +
+                       " holds a number that is not finite (the reader would "
+                       "refuse the file)");
   EXPECT_FALSE(std::filesystem::exists(path));
 }
 
