@@ -160,9 +160,14 @@ def test_flagfile_errors_name_the_file_and_line(small, tmp_path):
     looped.write_text(f"--flagfile={looped}\n")
     with pytest.raises(ValueError, match="includes itself"):
         rffslam.solve(small, flagfile=looped)
-    # gflags would exit on an empty entry of a list; the check skips it.
+    # An empty entry of a list is an error, as on the command line (gflags
+    # would skip it or exit), naming the line.
     good = flagfile(tmp_path, "--prior=wnoa\n", "good.flags")
     listed = flagfile(tmp_path, f"--flagfile={good},,{good}\n", "list.flags")
+    with pytest.raises(ValueError, match=f"{listed}:1: --flagfile=.*: an "
+                                         "empty file name"):
+        rffslam.solve(small, flagfile=listed)
+    listed.write_text(f"--flagfile={good},{good}\n")
     assert rffslam.solve(small, flagfile=listed).summary["prior"] == "wnoa"
 
 
