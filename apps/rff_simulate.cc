@@ -223,6 +223,16 @@ int main(int argc, char** argv) {
     options.gp_heading_kernel_variance = FLAGS_gp_heading_kernel_variance;
   }
 
+  if (!rff::ValidateSimulationOptions(options, &error)) return Fail(error);
+  // Without a visibility model or nearest-first selection no distance is
+  // checked: a given --min_range would change nothing.
+  if (Given("min_range") && !(options.sensor_range > 0.0) &&
+      !options.observe_nearest) {
+    return Fail(rff::OptionError(
+        "min_range", rff::FormatNumber(FLAGS_min_range),
+        "applies with --sensor_range > 0 or --observe_nearest only"));
+  }
+
   rff::Dataset dataset;
   if (!rff::Simulate(options, &dataset, &error)) return Fail(error);
   if (!rff::WriteDataset(dataset, FLAGS_output, &error)) return Fail(error);

@@ -286,6 +286,13 @@ const AppCase kAppCases[] = {
      "{bin}/rff_simulate --output={dir}/s.rffd --landmarks=-3",
      "rff_simulate: error: --landmarks=-3: allowed 1 to 10000000\n",
      "{dir}/s.rffd"},
+    // No visibility model, no nearest-first selection: it would change
+    // nothing.
+    {"SimulateMinRangeWithoutAUse",
+     "{bin}/rff_simulate --output={dir}/s.rffd --min_range=5",
+     "rff_simulate: error: --min_range=5: applies with --sensor_range > 0 or "
+     "--observe_nearest only\n",
+     "{dir}/s.rffd"},
     {"SimulateZeroTimeStep", "{bin}/rff_simulate --output={dir}/s.rffd --dt=0",
      "rff_simulate: error: --dt=0: allowed more than 0 up to 1e+06\n",
      "{dir}/s.rffd"},
@@ -361,12 +368,20 @@ const AppCase kAppCases[] = {
      "path\n",
      ""},
     {"PerturbMissingInput",
-     "{bin}/rff_perturb --input={dir}/none.rffd --output={dir}/p.rffd",
+     "{bin}/rff_perturb --input={dir}/none.rffd --output={dir}/p.rffd "
+     "--landmark_prior_offset=1",
      "rff_perturb: error: {dir}/none.rffd: cannot open for reading",
      "{dir}/p.rffd"},
     {"PerturbBadLine",
-     "{bin}/rff_perturb --input={dir}/bad.rffd --output={dir}/p.rffd",
+     "{bin}/rff_perturb --input={dir}/bad.rffd --output={dir}/p.rffd "
+     "--landmark_prior_offset=1",
      "rff_perturb: error: {dir}/bad.rffd:3: RANGE needs 4 fields, got 3",
+     "{dir}/p.rffd"},
+    // No perturbation: the copy would pass for a perturbed file.
+    {"PerturbNothing",
+     "{bin}/rff_perturb --input={dir}/valid.rffd --output={dir}/p.rffd",
+     "rff_perturb: error: nothing to perturb: give --landmark_prior_offset, "
+     "--start_heading_offset_deg or --start_heading_sigma\n",
      "{dir}/p.rffd"},
     {"PerturbNegativeOffset",
      "{bin}/rff_perturb --input={dir}/valid.rffd --output={dir}/p.rffd "
