@@ -10,9 +10,13 @@
 //   rff_convert --to=pyfg|g2o --input=IN.rffd --output=OUT
 #include <gflags/gflags.h>
 
+#include <algorithm>
 #include <cstdio>
+#include <cstdlib>
 #include <map>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "rff_ceres/convert/g2o.h"
 #include "rff_ceres/convert/mrclam.h"
@@ -305,6 +309,41 @@ bool WriteG2oFile(const rff::Dataset& dataset, std::string* error) {
   return true;
 }
 
+// The input formats a flag applies to (by name, or by its prefix ending in
+// '_'); given for another format it would change nothing.
+bool CheckFlagsApply(const std::string& format, std::string* error) {
+  const std::vector<std::pair<std::string, std::vector<std::string>>> scopes = {
+      {"plaza_", {"plaza"}},
+      {"mrclam_", {"mrclam"}},
+      {"gt_rate_hz", {"mrclam"}},
+      {"robot", {"pyfg"}},
+      {"rate", {"pyfg", "g2o"}},
+      {"prior_sigma_xy", {"plaza", "mrclam", "pyfg", "g2o"}},
+      {"prior_sigma_theta", {"plaza", "mrclam", "pyfg", "g2o"}}};
+  std::vector<gflags::CommandLineFlagInfo> flags;
+  gflags::GetAllFlags(&flags);
+  for (const auto& [name, formats] : scopes) {
+    for (const gflags::CommandLineFlagInfo& flag : flags) {
+      const bool named = name.back() == '_' ? flag.name.rfind(name, 0) == 0
+                                            : flag.name == name;
+      if (!named || flag.is_default ||
+          std::find(formats.begin(), formats.end(), format) != formats.end()) {
+        continue;
+      }
+      // A double as given (gflags prints 17 digits).
+      const std::string value = flag.type == "double"
+                                    ? rff::FormatNumber(std::strtod(
+                                          flag.current_value.c_str(), nullptr))
+                                    : flag.current_value;
+      *error = rff::OptionError(
+          flag.name, value,
+          "applies to --format=" + rff::JoinAlternatives(formats) + " only");
+      return false;
+    }
+  }
+  return true;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -351,6 +390,7 @@ int main(int argc, char** argv) {
       !rff::CheckMrclamOptions(mrclam, &error)) {
     return Fail(error);
   }
+  if (!CheckFlagsApply(format, &error)) return Fail(error);
   rff::Dataset dataset;
   bool ok;
   if (format == "plaza") {

@@ -234,6 +234,18 @@ const AppCase kAppCases[] = {
      "{bin}/rff_convert --format=g2o --input={dir}/valid.rffd --rate=-1 "
      "--output={dir}/o.rffd",
      "rff_convert: error: --rate=-1: allowed 0 or more\n", "{dir}/o.rffd"},
+    // A flag of another format would change nothing.
+    {"ConvertMrclamFlagForPlaza",
+     "{bin}/rff_convert --format=plaza --input={dir} --mrclam_robot=1 "
+     "--output={dir}/o.rffd",
+     "rff_convert: error: --mrclam_robot=1: applies to --format=mrclam "
+     "only\n",
+     "{dir}/o.rffd"},
+    {"ConvertRateForADataset",
+     "{bin}/rff_convert --input={dir}/valid.rffd --to=g2o --rate=10 "
+     "--output={dir}/o.g2o",
+     "rff_convert: error: --rate=10: applies to --format=pyfg or g2o only\n",
+     "{dir}/o.g2o"},
     {"ConvertNoInput", "{bin}/rff_convert --format=plaza --output={dir}/o.rffd",
      "rff_convert: error: --input=DIR is required", "{dir}/o.rffd"},
     {"ConvertNoOutput", "{bin}/rff_convert --format=plaza --input={dir}",
