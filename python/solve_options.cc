@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "apps/slam_flags.h"
+#include "apps/tool_flags.h"
 #include "gflags/gflags.h"
 #include "rff_ceres/io/flagfile_check.h"
 #include "rff_ceres/option_error.h"
@@ -65,14 +66,10 @@ bool SlamOptionsFromSettings(const std::vector<Setting>& settings,
   // Every call starts from the flags as they are (their defaults) and leaves
   // them so.
   gflags::FlagSaver saver;
+  // The solver's flags only, each as the tools tell its kind.
   const FlagKindOf kind_of = [](const std::string& name) {
-    if (IsNegatedSlamFlag(name)) return FlagKind::kBoolean;
-    gflags::CommandLineFlagInfo info;
-    if (!IsSlamFlag(name) ||
-        !gflags::GetCommandLineFlagInfo(name.c_str(), &info)) {
-      return FlagKind::kUnknown;
-    }
-    return info.type == "bool" ? FlagKind::kBoolean : FlagKind::kValued;
+    return IsSlamFlag(name) || IsNegatedSlamFlag(name) ? ToolFlagKind(name)
+                                                       : FlagKind::kUnknown;
   };
   // gflags parses each line as it would in the file, alone so that a bad
   // value is named with its line.

@@ -103,8 +103,9 @@ bool InitializeLandmarks(const Dataset& dataset, const PoseFunction& pose,
   // bearing undefined where the solve starts: it starts one prior sigma
   // along the bearing instead, where both allow it.
   for (const Observation& o : dataset.observations) {
+    if (!o.HasBearing()) continue;
     const auto sigma = prior_sigma.find(o.id);
-    if (!o.HasBearing() || sigma == prior_sigma.end()) continue;
+    if (sigma == prior_sigma.end()) continue;
     const Eigen::Vector3d p = pose(o.t);
     Eigen::Vector2d& l = (*landmarks)[o.id];
     if ((l - p.head<2>()).squaredNorm() > kMinBearingSquaredDistance) continue;

@@ -473,21 +473,9 @@ bool WriteG2o(const Dataset& input, std::ostream* output,
   return true;
 }
 
-namespace {
-
-// Whether ParseG2o takes `text` back with its default options.
-bool ReadsBack(std::istream* text, const std::string& source,
-               std::string* why) {
-  Dataset dataset;
-  G2oReadSummary summary;
-  return ParseG2o(text, source, G2oReadOptions(), &dataset, &summary, why);
-}
-
-}  // namespace
-
 bool WriteG2o(const Dataset& dataset, const std::string& path,
               G2oWriteSummary* summary, std::string* error) {
-  return WriteGraphFile<G2oWriteSummary>(&WriteG2o, &ReadsBack, dataset, path,
+  return WriteGraphFile<G2oWriteSummary>(&WriteG2o, &ParseG2o, dataset, path,
                                          summary, error);
 }
 

@@ -72,20 +72,24 @@ std::string JoinNumbers(const std::vector<double>& values);
 
 // Writes the text a format's stream writer `write` makes of `dataset` to
 // `path`, whole or not at all (WriteOutputFile), and never a text the
-// format's reader `read_back` refuses (a sigma whose square overflows or
-// whose information underflows): it names the refusal instead.
-template <typename Summary>
+// format's parser `parse` refuses with its default options (a sigma whose
+// square overflows or whose information underflows): it names the refusal
+// instead.
+template <typename Summary, typename ReadOptions, typename ReadSummary>
 bool WriteGraphFile(bool (*write)(const Dataset&, std::ostream*, Summary*,
                                   std::string*),
-                    bool (*read_back)(std::istream*, const std::string&,
-                                      std::string*),
+                    bool (*parse)(std::istream*, const std::string&,
+                                  const ReadOptions&, Dataset*, ReadSummary*,
+                                  std::string*),
                     const Dataset& dataset, const std::string& path,
                     Summary* summary, std::string* error) {
   std::ostringstream text;
   if (!write(dataset, &text, summary, error)) return false;
   std::istringstream written(text.str());
+  Dataset back;
+  ReadSummary read;
   std::string why;
-  if (!read_back(&written, path, &why)) {
+  if (!parse(&written, path, ReadOptions(), &back, &read, &why)) {
     *error = path + ": not written: its reader would refuse it: " + why;
     return false;
   }

@@ -564,21 +564,9 @@ bool WritePyfg(const Dataset& dataset, std::ostream* output,
   return true;
 }
 
-namespace {
-
-// Whether ParsePyfg takes `text` back with its default options.
-bool ReadsBack(std::istream* text, const std::string& source,
-               std::string* why) {
-  Dataset dataset;
-  PyfgReadSummary summary;
-  return ParsePyfg(text, source, PyfgReadOptions(), &dataset, &summary, why);
-}
-
-}  // namespace
-
 bool WritePyfg(const Dataset& dataset, const std::string& path,
                PyfgWriteSummary* summary, std::string* error) {
-  return WriteGraphFile<PyfgWriteSummary>(&WritePyfg, &ReadsBack, dataset, path,
+  return WriteGraphFile<PyfgWriteSummary>(&WritePyfg, &ParsePyfg, dataset, path,
                                           summary, error);
 }
 

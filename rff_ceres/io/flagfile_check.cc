@@ -37,11 +37,16 @@ std::vector<std::string> SplitCommas(const std::string& list) {
   return items;
 }
 
-// A --flagfile list with an empty name: gflags skips it, and the file the
-// user meant would be lost.
-bool HasEmptyName(const std::string& list) {
-  return SplitCommas(list).empty() || list.find(",,") != std::string::npos ||
-         list.front() == ',' || list.back() == ',';
+// Whether a --flagfile list names a file in each entry; an empty name
+// gflags skips, and the file the user meant would be lost.
+bool NamesEveryFile(const std::string& list, std::string* error) {
+  if (SplitCommas(list).empty() || list.find(",,") != std::string::npos ||
+      list.front() == ',' || list.back() == ',') {
+    *error = OptionError("flagfile", list, "an empty file name",
+                         "comma-separated file paths");
+    return false;
+  }
+  return true;
 }
 
 std::string Trim(const std::string& text) {
@@ -127,10 +132,8 @@ bool CheckFlagfile(const std::string& path, const FlagKindOf& kind_of,
       return false;
     }
     if (name == "flagfile") {
-      if (HasEmptyName(FlagValue(text))) {
-        *error = where + OptionError("flagfile", FlagValue(text),
-                                     "an empty file name",
-                                     "comma-separated file paths");
+      if (!NamesEveryFile(FlagValue(text), error)) {
+        *error = where + *error;
         return false;
       }
       for (const std::string& nested : SplitCommas(FlagValue(text))) {
@@ -138,16 +141,18 @@ bool CheckFlagfile(const std::string& path, const FlagKindOf& kind_of,
           return false;
         }
       }
-    } else if (kind_of(name) == FlagKind::kUnknown) {
+      continue;
+    }
+    const FlagKind kind = kind_of(name);
+    if (kind == FlagKind::kUnknown) {
       *error = where + "unknown flag '--" + name + "'";
       return false;
-    } else if (kind_of(name) == FlagKind::kValued &&
-               text.find('=') == std::string::npos) {
+    }
+    if (kind == FlagKind::kValued && text.find('=') == std::string::npos) {
       *error = where + "'--" + name + "' needs a value: --" + name + "=VALUE";
       return false;
-    } else if (on_flag && !on_flag(where, line, error)) {
-      return false;
     }
+    if (on_flag && !on_flag(where, line, error)) return false;
   }
   open->pop_back();
   return true;
@@ -171,11 +176,7 @@ bool CheckFlagfiles(const std::vector<std::string>& args,
     }
     if (!CheckFromEnvironment(name, list, error)) return false;
     if (name != "flagfile") continue;
-    if (HasEmptyName(list)) {
-      *error = OptionError("flagfile", list, "an empty file name",
-                           "comma-separated file paths");
-      return false;
-    }
+    if (!NamesEveryFile(list, error)) return false;
     for (const std::string& path : SplitCommas(list)) {
       std::vector<std::string> open;
       if (!CheckFlagfile(path, kind_of, on_flag, &open, read, error)) {
