@@ -51,7 +51,9 @@ DEFINE_double(sigma_bearing_deg, 2.0,
               "up to 360.");
 DEFINE_int32(observations_per_step, 4,
              "Landmarks observed per pose (kitti_scale: up to 15 visible), "
-             "1 or more; with --num_steps at most 20000000 observations.");
+             "1 or more, at most --landmarks without --sensor_range or "
+             "--observe_nearest; with --num_steps at most 20000000 "
+             "observations.");
 DEFINE_bool(odometry, true, "Write ODOM records between consecutive poses.");
 DEFINE_double(odometry_sigma_xy, 0.05, "Odometry translation sigma in m.");
 DEFINE_double(odometry_sigma_theta, 0.01, "Odometry rotation sigma in rad.");

@@ -573,6 +573,16 @@ bool ValidateSimulationOptions(const SimulationOptions& o, std::string* error) {
         "more than --landmarks=" + std::to_string(o.num_landmarks) +
             ", and no --sensor_range to place more",
         "at most " + std::to_string(o.num_landmarks)));
+  } else if (o.sensor_range == 0.0 && !o.observe_nearest &&
+             o.observations_per_step > o.num_landmarks) {
+    // Each step observes distinct landmarks, drawn from all of them.
+    check.Fail(OptionError(
+        "observations_per_step", std::to_string(o.observations_per_step),
+        "more than --landmarks=" + std::to_string(o.num_landmarks) +
+            ", and each step observes distinct landmarks",
+        "at most " + std::to_string(o.num_landmarks) +
+            " (or a --sensor_range or --observe_nearest, which observe as "
+            "many as they find)"));
   } else if (static_cast<std::int64_t>(o.num_steps) *
                  (o.sensor_range > 0.0
                       ? o.observations_per_step

@@ -75,7 +75,8 @@ struct SimulationOptions {
   double sigma_bearing = 2.0 * M_PI / 180.0;  // rad
   // Landmarks observed per pose: distinct, drawn at random among all
   // landmarks, or among the visible ones when sensor_range > 0 (then fewer
-  // if fewer are visible). Clamped to the number of candidates.
+  // if fewer are visible), at most num_landmarks without sensor_range or
+  // observe_nearest.
   int observations_per_step = 4;
   // Observe the observations_per_step nearest candidates at least min_range
   // away (ties by id) instead of a random sample: a sensor that reports

@@ -350,6 +350,7 @@ TEST(SimulateTest, EveryVariantParsesBack) {
         options.kind = kind;
         options.odometry = odometry;
         options.num_landmarks = landmarks;
+        options.observations_per_step = std::min(4, landmarks);
         options.sigma_range = 5.0;
         options.sigma_bearing = 10.0 * M_PI / 180.0;
         options.landmark_prior_sigma = landmarks == 5 ? 0.0 : 5.0;
@@ -359,7 +360,6 @@ TEST(SimulateTest, EveryVariantParsesBack) {
         std::istringstream input(ToText(simulated));
         Dataset parsed;
         ASSERT_TRUE(ParseDataset(&input, "x.rffd", &parsed, &error)) << error;
-        // Clamped to the number of landmarks there are.
         EXPECT_EQ(parsed.observations.size(), 300u * std::min(4, landmarks));
         EXPECT_EQ(parsed.odometry.size(), odometry ? 299u : 0u);
         EXPECT_EQ(parsed.landmark_priors.size(),
@@ -546,6 +546,10 @@ TEST(SimulateTest, RejectsBadOptionsWithAMessage) {
       {[](SimulationOptions* o) { o->min_visible_landmarks = 60; },
        "--min_visible_landmarks=60: more than --landmarks=50, and no "
        "--sensor_range to place more; allowed at most 50"},
+      {[](SimulationOptions* o) { o->observations_per_step = 51; },
+       "--observations_per_step=51: more than --landmarks=50, and each step "
+       "observes distinct landmarks; allowed at most 50 (or a --sensor_range "
+       "or --observe_nearest, which observe as many as they find)"},
       {[](SimulationOptions* o) {
          o->num_steps = 10000000;
          o->num_landmarks = 10;

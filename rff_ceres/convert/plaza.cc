@@ -248,6 +248,8 @@ struct OdometryAgreement {
   // Normalised correlation of the GT and DR heading increments; NaN below
   // kMinMeasuredTurning.
   double turn_agreement = std::numeric_limits<double>::quiet_NaN();
+  // The sums overflowed: distances or coordinates no recording has.
+  bool overflowed = false;
 };
 
 OdometryAgreement MeasureOdometryAgreement(const PlazaRaw& raw) {
@@ -270,8 +272,8 @@ OdometryAgreement MeasureOdometryAgreement(const PlazaRaw& raw) {
     sum_hh += h * h;
     turning += std::abs(g);
   }
-  // Overflowing sums (absurd coordinates) measure nothing either.
-  if (travel >= kMinMeasuredTravel && std::isfinite(sum_x + sum_y + sum_d2)) {
+  result.overflowed = !std::isfinite(sum_x + sum_y + sum_d2 + travel);
+  if (travel >= kMinMeasuredTravel && !result.overflowed) {
     result.heading_offset = std::atan2(sum_y, sum_x);
     result.distance_ratio = std::hypot(sum_x, sum_y) / sum_d2;
   }
@@ -296,6 +298,12 @@ bool ResolveHeadingOffset(const std::string& prefix,
   const std::string dr_path = prefix + "_DR.txt";
   const OdometryAgreement agreement = MeasureOdometryAgreement(raw);
   summary->measured_heading_offset = agreement.heading_offset;
+  if (agreement.overflowed) {
+    *error = prefix + "_{GT,DR}.txt: the DR distances and the ground-truth " +
+             "displacements overflow double precision when compared: " +
+             "distances or coordinates no recording has";
+    return false;
+  }
   if (std::isfinite(agreement.distance_ratio) &&
       !(agreement.distance_ratio >= kMinDistanceRatio &&
         agreement.distance_ratio <= kMaxDistanceRatio)) {

@@ -606,6 +606,15 @@ TEST(PlazaHeadingOffsetTest, RejectsDrColumnsInAnotherConvention) {
                            })),
               HasSubstr("/Rot_DR.txt: the DR distances do not match the "
                         "ground truth (GT moves 0.3048 m per DR metre)"));
+  // A distance whose square overflows: nothing could be compared.
+  EXPECT_EQ(RotatedError(dir, 0.0, "", "Rot_DR.txt",
+                         dr_with([](std::size_t k, double* d, double*) {
+                           if (k == 3) *d = 1e308;
+                         })),
+            dir +
+                "/Rot_{GT,DR}.txt: the DR distances and the ground-truth "
+                "displacements overflow double precision when compared: "
+                "distances or coordinates no recording has");
 }
 
 TEST(PlazaBundledTest, CountsFirstRecordsAndDeadReckoning) {
