@@ -94,29 +94,45 @@ std::string UnresolvedObservation(const Observation& o) {
   return why;
 }
 
+// How messages name a record: its keyword and its time, or its id.
+std::string RecordName(const PosePrior& p) {
+  return "PRIOR_POSE at t = " + FormatNumber(p.pose.t);
+}
+std::string RecordName(const LandmarkPrior& p) {
+  return "PRIOR_LANDMARK " + std::to_string(p.id);
+}
+std::string RecordName(const Odometry& o) {
+  return "ODOM at t = " + FormatNumber(o.t0);
+}
+std::string RecordName(const Observation& o) {
+  return std::string(MeasurementTypeOf(o.type).record) +
+         " at t = " + FormatNumber(o.t);
+}
+std::string RecordName(const TimedPose& p) {
+  return "GT_POSE at t = " + FormatNumber(p.t);
+}
+std::string RecordName(const Landmark& l) {
+  return "GT_LANDMARK " + std::to_string(l.id);
+}
+
 // The first record the reader would refuse for its sigmas, as
 // "RECORD at t = T: why"; empty when there is none.
 std::string FirstUnresolvedSigma(const Dataset& dataset) {
   for (const PosePrior& p : dataset.pose_priors) {
     const std::string why = UnresolvedPosePrior(p);
-    if (!why.empty())
-      return "PRIOR_POSE at t = " + FormatNumber(p.pose.t) + ": " + why;
+    if (!why.empty()) return RecordName(p) + ": " + why;
   }
   for (const LandmarkPrior& p : dataset.landmark_priors) {
     const std::string why = UnresolvedLandmarkPrior(p);
-    if (!why.empty())
-      return "PRIOR_LANDMARK " + std::to_string(p.id) + ": " + why;
+    if (!why.empty()) return RecordName(p) + ": " + why;
   }
   for (const Odometry& o : dataset.odometry) {
     const std::string why = UnresolvedOdometry(o);
-    if (!why.empty()) return "ODOM at t = " + FormatNumber(o.t0) + ": " + why;
+    if (!why.empty()) return RecordName(o) + ": " + why;
   }
   for (const Observation& o : dataset.observations) {
     const std::string why = UnresolvedObservation(o);
-    if (!why.empty()) {
-      return std::string(MeasurementTypeOf(o.type).record) +
-             " at t = " + FormatNumber(o.t) + ": " + why;
-    }
+    if (!why.empty()) return RecordName(o) + ": " + why;
   }
   return "";
 }
@@ -132,33 +148,28 @@ std::string FirstNonFinite(const Dataset& dataset) {
   for (const PosePrior& p : dataset.pose_priors) {
     if (!finite({p.pose.t, p.pose.x, p.pose.y, p.pose.theta, p.sigma_xy,
                  p.sigma_theta})) {
-      return "PRIOR_POSE at t = " + FormatNumber(p.pose.t);
+      return RecordName(p);
     }
   }
   for (const LandmarkPrior& p : dataset.landmark_priors) {
-    if (!finite({p.x, p.y, p.sigma})) {
-      return "PRIOR_LANDMARK " + std::to_string(p.id);
-    }
+    if (!finite({p.x, p.y, p.sigma})) return RecordName(p);
   }
   for (const Odometry& o : dataset.odometry) {
     if (!finite({o.t0, o.t1, o.dx, o.dy, o.dtheta, o.sigma_x, o.sigma_y,
                  o.sigma_theta})) {
-      return "ODOM at t = " + FormatNumber(o.t0);
+      return RecordName(o);
     }
   }
   for (const Observation& o : dataset.observations) {
     if (!finite({o.t, o.range, o.bearing, o.sigma_range, o.sigma_bearing})) {
-      return std::string(MeasurementTypeOf(o.type).record) +
-             " at t = " + FormatNumber(o.t);
+      return RecordName(o);
     }
   }
   for (const TimedPose& p : dataset.ground_truth) {
-    if (!finite({p.t, p.x, p.y, p.theta})) {
-      return "GT_POSE at t = " + FormatNumber(p.t);
-    }
+    if (!finite({p.t, p.x, p.y, p.theta})) return RecordName(p);
   }
   for (const Landmark& l : dataset.ground_truth_landmarks) {
-    if (!finite({l.x, l.y})) return "GT_LANDMARK " + std::to_string(l.id);
+    if (!finite({l.x, l.y})) return RecordName(l);
   }
   return "";
 }
