@@ -100,14 +100,16 @@ std::shared_ptr<const MeanFunction> BuildMean(
     settled->problem.noise = wnoa.noise;  // Learned from the same data.
     result->noise_kept = wnoa.noise_kept;
     result->noise_learned = wnoa.noise_learned;
+    // The solve's landmarks start the RFF solve either way: as a mean, the
+    // trajectory is already where the correction starts.
+    for (const Landmark& l : wnoa.landmarks) {
+      warm->start.landmarks[l.id] = Eigen::Vector2d(l.x, l.y);
+    }
     if (wnoa_mean) {
       mean = std::make_shared<PiecewiseLinearMean>(wnoa.trajectory);
       *wnoa_mean_solve = std::move(wnoa);
     } else {
       warm->start.poses = wnoa.trajectory;
-      for (const Landmark& l : wnoa.landmarks) {
-        warm->start.landmarks[l.id] = Eigen::Vector2d(l.x, l.y);
-      }
     }
   }
   if (!mean) {

@@ -18,9 +18,10 @@
 namespace rff {
 
 // The prior mean. The RFF prior starts from a WNOA solve: as its mean with
-// a "wnoa" mean (kept in `wnoa_mean_solve`); as its initial value (`warm`)
-// without odometry, where the localisation pilot has no motion model to
-// bridge gaps between fixes. `settled` takes the losses and noise scales
+// a "wnoa" mean (kept in `wnoa_mean_solve`); as its initial trajectory
+// (`warm`) without odometry, where the localisation pilot has no motion
+// model to bridge gaps between fixes. Its landmarks start the RFF solve
+// either way (`warm`). `settled` takes the losses and noise scales
 // that solve settled on. Null, with `error`, on failure.
 std::shared_ptr<const MeanFunction> BuildMean(
     const Dataset& dataset, const Dataset& resolved, const SlamOptions& options,
