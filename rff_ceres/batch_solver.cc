@@ -78,12 +78,15 @@ bool SolveBatch(const Dataset& dataset, const SlamOptions& options,
                 ceres::Solver::Options ceres_options, TrajectoryModel* model,
                 std::map<LandmarkId, Eigen::Vector2d>* landmarks,
                 double initial_extent, std::unique_ptr<SlamProblem>* problem,
-                SlamResult* result, std::string* error) {
-  for (int round = 0;; ++round) {
-    *problem = std::make_unique<SlamProblem>(model, options.problem);
-    (*problem)->set_range_calibration(result->range_calibration);
-    (*problem)->set_odometry_calibration(result->odometry_calibration);
-    if (!(*problem)->Build(dataset, *landmarks, error)) return false;
+                SlamResult* result, std::string* error, bool reuse_problem) {
+  bool reuse = reuse_problem && *problem != nullptr;
+  for (int round = 0;; ++round, reuse = false) {
+    if (!reuse) {
+      *problem = std::make_unique<SlamProblem>(model, options.problem);
+      (*problem)->set_range_calibration(result->range_calibration);
+      (*problem)->set_odometry_calibration(result->odometry_calibration);
+      if (!(*problem)->Build(dataset, *landmarks, error)) return false;
+    }
     ChooseLinearSolver(options.solver, *model, &ceres_options, result);
     const bool solved =
         RunSolve(options.solver, ceres_options, problem->get(), result, error,

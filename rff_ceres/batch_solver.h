@@ -31,12 +31,16 @@ bool CollectTrajectory(const Dataset& dataset, const TrajectoryModel& model,
                        std::string* error);
 
 // Paper III-B.2: after each solve the prior mean becomes a smoothing spline
-// of the estimate and the weights restart from zero.
+// of the estimate and the weights restart from zero. With
+// `reuse_problem`, the first solve is of `*problem` as it stands (built
+// over `model` with `options.problem`, its costs following the model's
+// scales in place: TrajectoryModel::AdoptScales) instead of a new build.
 bool SolveBatch(const Dataset& dataset, const SlamOptions& options,
                 ceres::Solver::Options ceres_options, TrajectoryModel* model,
                 std::map<LandmarkId, Eigen::Vector2d>* landmarks,
                 double initial_extent, std::unique_ptr<SlamProblem>* problem,
-                SlamResult* result, std::string* error);
+                SlamResult* result, std::string* error,
+                bool reuse_problem = false);
 
 }  // namespace rff
 

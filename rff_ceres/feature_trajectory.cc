@@ -333,6 +333,11 @@ const std::vector<FeatureTrajectory::Features>& FeatureTrajectory::FeaturesAt(
     double t) const {
   auto it = cache_.find(t);
   if (it != cache_.end()) return it->second;
+  return cache_.emplace(t, EvaluateFeatures(t)).first->second;
+}
+
+std::vector<FeatureTrajectory::Features> FeatureTrajectory::EvaluateFeatures(
+    double t) const {
   std::vector<Features> features;
   // The stretch holding t, or the nearest within reach_ of its ends.
   const auto after = std::upper_bound(
@@ -348,7 +353,7 @@ const std::vector<FeatureTrajectory::Features>& FeatureTrajectory::FeaturesAt(
   if (after != stretches_.end() && after->begin - t < distance) {
     nearest = &*after;
   }
-  if (!nearest) return cache_.emplace(t, std::move(features)).first->second;
+  if (!nearest) return features;
   const Stretch& stretch = *nearest;
   const double tau = t - stretch.begin;
   const int first = stretch.first_segment;
@@ -382,7 +387,47 @@ const std::vector<FeatureTrajectory::Features>& FeatureTrajectory::FeaturesAt(
     *heading *= weight;
     features.push_back({s, position, heading});
   }
-  return cache_.emplace(t, std::move(features)).first->second;
+  return features;
+}
+
+bool FeatureTrajectory::AdoptScales(TrajectoryModel* rescaled) {
+  auto* other = dynamic_cast<FeatureTrajectory*>(rescaled);
+  if (other == nullptr || other->mean_ != mean_ ||
+      other->offsets_ != offsets_ || other->reach_ != reach_ ||
+      other->stretches_.size() != stretches_.size() ||
+      other->segments_.size() != segments_.size()) {
+    return false;
+  }
+  for (std::size_t i = 0; i < stretches_.size(); ++i) {
+    const Stretch &a = stretches_[i], &b = other->stretches_[i];
+    if (a.begin != b.begin || a.end != b.end || a.overlap != b.overlap ||
+        a.first_segment != b.first_segment ||
+        a.num_segments != b.num_segments) {
+      return false;
+    }
+  }
+  for (std::size_t i = 0; i < segments_.size(); ++i) {
+    if (segments_[i].begin != other->segments_[i].begin ||
+        segments_[i].end != other->segments_[i].end) {
+      return false;
+    }
+  }
+  // Offsets equal: every segment has the same feature counts.
+  options_ = other->options_;
+  position_kernel_ = std::move(other->position_kernel_);
+  heading_kernel_ = std::move(other->heading_kernel_);
+  for (std::size_t i = 0; i < segments_.size(); ++i) {
+    segments_[i].position_map = std::move(other->segments_[i].position_map);
+    segments_[i].heading_map = std::move(other->segments_[i].heading_map);
+  }
+  for (auto& [t, features] : cache_) {
+    const std::vector<Features> fresh = EvaluateFeatures(t);
+    for (std::size_t i = 0; i < features.size(); ++i) {
+      *features[i].position = *fresh[i].position;
+      *features[i].heading = *fresh[i].heading;
+    }
+  }
+  return true;
 }
 
 PoseMap FeatureTrajectory::PoseAt(double t) const {

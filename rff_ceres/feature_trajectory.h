@@ -135,6 +135,10 @@ class FeatureTrajectory : public TrajectoryModel {
   void set_mean(std::shared_ptr<const MeanFunction> mean) override {
     mean_ = std::move(mean);
   }
+  // With the same segments and feature counts, the kernels of `rescaled`
+  // replace this model's and every cached feature vector, which the
+  // problem's pose maps share, is evaluated again in place.
+  bool AdoptScales(TrajectoryModel* rescaled) override;
 
  private:
   // Create; `any_run`: `times` stand for any run (CheckOptions).
@@ -164,12 +168,14 @@ class FeatureTrajectory : public TrajectoryModel {
     std::unique_ptr<FeatureMap> position_map, heading_map;
   };
   // Blend-weighted features of the (one or two) segments active at a time.
+  // Shared with the pose maps as const; AdoptScales rewrites them.
   struct Features {
     int segment = 0;
-    std::shared_ptr<const Eigen::VectorXd> position;
-    std::shared_ptr<const Eigen::VectorXd> heading;
+    std::shared_ptr<Eigen::VectorXd> position;
+    std::shared_ptr<Eigen::VectorXd> heading;
   };
   const std::vector<Features>& FeaturesAt(double t) const;
+  std::vector<Features> EvaluateFeatures(double t) const;
   // Appends the segments of one stretch of `data`, `length` seconds long.
   bool AddStretch(const FeatureTrajectoryOptions& options,
                   const TimeInterval& data, double length, std::string* error);

@@ -187,14 +187,24 @@ bool LearnScales(const Dataset& dataset,
         CreateTrajectoryModel(dataset, *settled, mean, error);
     if (!rescaled) return false;
     rescaled->AdoptCaches(**model);
-    *model = std::move(rescaled);
+    // The problem as built serves where its residuals are the same and its
+    // costs can follow the new scales in place.
+    const bool in_place = (*problem)->BuiltWith(settled->problem) &&
+                          (*model)->AdoptScales(rescaled.get());
+    if (in_place) {
+      (*problem)->DropLinearization();
+      // As a new model's: the refit below starts from zero.
+      SetModelBlocks(std::vector<double>(blocks.size(), 0.0), model->get());
+    } else {
+      *model = std::move(rescaled);
+    }
     if (!prior.has_features()) {
       SetModelBlocks(blocks, model->get());
     } else if (!FitModelToPoses(estimate, model->get(), error)) {
       return false;
     }
     if (!SolveBatch(dataset, *settled, placing_options, model->get(), landmarks,
-                    initial_extent, problem, result, error)) {
+                    initial_extent, problem, result, error, in_place)) {
       return false;
     }
     note_radius();
@@ -213,9 +223,11 @@ bool LearnScales(const Dataset& dataset,
     final_options.initial_trust_region_radius =
         std::min(reached_radius, ceres_options.max_trust_region_radius);
   }
-  return !loose ||
-         SolveBatch(dataset, *settled, final_options, model->get(), landmarks,
-                    initial_extent, problem, result, error);
+  // The model is the last round's: a problem built over it with the same
+  // residuals is the one to solve.
+  return !loose || SolveBatch(dataset, *settled, final_options, model->get(),
+                              landmarks, initial_extent, problem, result, error,
+                              (*problem)->BuiltWith(settled->problem));
 }
 
 }  // namespace rff

@@ -80,6 +80,26 @@ ceres::LinearSolverType AutoLinearSolverType(const TrajectoryModel& model) {
              : ceres::SPARSE_NORMAL_CHOLESKY;
 }
 
+bool SlamProblem::BuiltWith(const ProblemOptions& o) const {
+  auto same_loss = [](const LossOptions& a, const LossOptions& b) {
+    return a.name == b.name && a.scale == b.scale;
+  };
+  const ProblemOptions& p = options_;
+  return same_loss(p.loss, o.loss) &&
+         same_loss(p.odometry_loss, o.odometry_loss) &&
+         p.noise.range == o.noise.range && p.noise.bearing == o.noise.bearing &&
+         p.noise.odometry == o.noise.odometry &&
+         p.range_calibration.estimate == o.range_calibration.estimate &&
+         p.range_calibration.scale_sigma == o.range_calibration.scale_sigma &&
+         p.range_calibration.offset_sigma == o.range_calibration.offset_sigma &&
+         p.odometry_calibration.estimate == o.odometry_calibration.estimate &&
+         p.odometry_calibration.scale_sigma ==
+             o.odometry_calibration.scale_sigma &&
+         p.use_odometry == o.use_odometry &&
+         p.preintegrate_odometry == o.preintegrate_odometry &&
+         p.max_preintegration_seconds == o.max_preintegration_seconds;
+}
+
 SlamProblem::SlamProblem(TrajectoryModel* model, const ProblemOptions& options)
     : model_(model), options_(options) {
   ceres::Problem::Options problem_options;

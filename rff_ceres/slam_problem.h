@@ -169,6 +169,9 @@ class SlamProblem {
 
   ceres::Problem* problem() { return problem_.get(); }
   const TrajectoryModel& model() const { return *model_; }
+  // Whether the residuals built under `options` are those of this problem:
+  // the same losses, noise scales, odometry and calibrations.
+  bool BuiltWith(const ProblemOptions& options) const;
   // (scale, offset) of the range sensor: (1, 0) unless estimated. Set it
   // before Begin() to start from another value.
   const Eigen::Vector2d& range_calibration() const {
@@ -231,8 +234,9 @@ class SlamProblem {
   // Moves it into `linearization` while the problem has the same number of
   // residual blocks and the same parameter blocks, each as constant and
   // with the same values, as when it was kept; false otherwise. None is
-  // kept after either way. Residuals changed another way (a cost or loss
-  // edited in place) go unseen: nothing here does that.
+  // kept after either way. Residuals changed another way (costs following
+  // a model's scales in place, TrajectoryModel::AdoptScales) go unseen:
+  // whoever changes them drops it.
   bool TakeLinearization(BandedLinearization* linearization);
   bool has_linearization() const { return kept_.hessian != nullptr; }
   // Frees it: a new solve must not hold an old H beside its own.

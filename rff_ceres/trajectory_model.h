@@ -79,6 +79,13 @@ class TrajectoryModel {
   // learning changed, computed that does not depend on the scales (WNOA:
   // the interpolation at each time). Nothing by default.
   virtual void AdoptCaches(const TrajectoryModel& /*previous*/) {}
+
+  // Takes the scales of `rescaled`, a model built as this one but for its
+  // prior's scales, where the costs already built over this model can
+  // follow them in place: their pose maps then equal `rescaled`'s bit for
+  // bit and the blocks keep their values. False, nothing changed, where
+  // the structure differs or the model cannot (the default).
+  virtual bool AdoptScales(TrajectoryModel* /*rescaled*/) { return false; }
 };
 
 // Every block's values in block order, and back (same model structure).

@@ -261,5 +261,53 @@ TEST(FeatureTrajectoryTest, MoreWeightsThanMemoryAllowsOverStretchesFails) {
             "this run, or --segment_length of at least 0.5905511811023622");
 }
 
+// The variances of `rescaled` taken in place: pose maps handed out before
+// (as a problem's costs hold them) then equal those of a model built with
+// the new variances, bit for bit, and the blocks keep their values.
+TEST(FeatureTrajectoryTest, AdoptScalesRewritesSharedFeaturesInPlace) {
+  std::string error;
+  FeatureTrajectoryOptions options = WindowedOptions(8);
+  const std::shared_ptr<const MeanFunction> mean = ZeroMean();
+  auto model = FeatureTrajectory::Create(options, mean, 0.0, 50.0, &error);
+  ASSERT_NE(model, nullptr) << error;
+  RandomizeWeights(model.get(), 7);
+  const std::vector<double> weights = ModelBlocks(*model);
+  const std::vector<double> times = {0.0, 13.5, 26.0, 49.0};
+  std::vector<PoseMap> held;
+  for (const double t : times) held.push_back(model->PoseAt(t));
+  options.position_kernel.variance = 0.03;
+  options.heading_kernel.variance = 0.5;
+  auto rescaled =
+      FeatureTrajectory::Create(options, ZeroMean(), 0.0, 50.0, &error);
+  ASSERT_NE(rescaled, nullptr) << error;
+  // A different mean object: the costs' maps carry the old one.
+  EXPECT_FALSE(model->AdoptScales(rescaled.get()));
+  auto same_mean = FeatureTrajectory::Create(options, mean, 0.0, 50.0, &error);
+  ASSERT_NE(same_mean, nullptr) << error;
+  const std::vector<PoseMap> expected = [&] {
+    std::vector<PoseMap> maps;
+    for (const double t : times) maps.push_back(same_mean->PoseAt(t));
+    return maps;
+  }();
+  ASSERT_TRUE(model->AdoptScales(same_mean.get()));
+  EXPECT_EQ(model->options().position_kernel.variance, 0.03);
+  EXPECT_EQ(ModelBlocks(*model), weights);
+  for (std::size_t i = 0; i < times.size(); ++i) {
+    ASSERT_EQ(held[i].terms.size(), expected[i].terms.size()) << times[i];
+    for (std::size_t k = 0; k < held[i].terms.size(); ++k) {
+      const Eigen::VectorXd& phi = *held[i].terms[k].phi;
+      EXPECT_TRUE(phi == *expected[i].terms[k].phi) << times[i] << " " << k;
+      EXPECT_TRUE(*model->PoseAt(times[i]).terms[k].phi == phi);
+    }
+  }
+  // Another capacity is another structure: refused, nothing changed.
+  FeatureTrajectoryOptions wider = options;
+  wider.num_position_features = 12;
+  auto other = FeatureTrajectory::Create(wider, mean, 0.0, 50.0, &error);
+  ASSERT_NE(other, nullptr) << error;
+  EXPECT_FALSE(model->AdoptScales(other.get()));
+  EXPECT_TRUE(*held[1].terms[0].phi == *expected[1].terms[0].phi);
+}
+
 }  // namespace
 }  // namespace rff

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <map>
 #include <set>
@@ -221,6 +222,44 @@ TEST(SlamSolverTest, FeatureWindowsTakeTheBandedCholeskyBeyondTheWorkRule) {
   EXPECT_NEAR(banded.summary.final_cost, ceres_side.summary.final_cost,
               1e-9 * ceres_side.summary.final_cost);
   EXPECT_LT(LargestPositionDifference(banded, ceres_side), 1e-9);
+}
+
+// What a problem's residuals depend on: each option below tells a problem
+// built with it apart from one built without (a learning round may then
+// not solve the problem it has again).
+TEST(SlamProblemTest, BuiltWithTellsEveryResidualOptionApart) {
+  const Dataset dataset = PaperDataset(5, 20, 5, 2);
+  const SlamOptions options = testing::SyntheticRangeBearingOptions();
+  std::string error;
+  const std::shared_ptr<const MeanFunction> mean =
+      BuildPriorMean(options.mean.name, dataset, &error);
+  ASSERT_NE(mean, nullptr) << error;
+  const std::unique_ptr<TrajectoryModel> model =
+      CreateTrajectoryModel(dataset, options, mean, &error);
+  ASSERT_NE(model, nullptr) << error;
+  const SlamProblem problem(model.get(), options.problem);
+  EXPECT_TRUE(problem.BuiltWith(options.problem));
+  const std::vector<std::function<void(ProblemOptions*)>> changes = {
+      [](ProblemOptions* o) { o->loss.name = "cauchy"; },
+      [](ProblemOptions* o) { o->loss.scale = 3.0; },
+      [](ProblemOptions* o) { o->odometry_loss.name = "none"; },
+      [](ProblemOptions* o) { o->odometry_loss.scale = 1.5; },
+      [](ProblemOptions* o) { o->noise.range = 0.5; },
+      [](ProblemOptions* o) { o->noise.bearing = 2.0; },
+      [](ProblemOptions* o) { o->noise.odometry = 0.7; },
+      [](ProblemOptions* o) { o->range_calibration.estimate = true; },
+      [](ProblemOptions* o) { o->range_calibration.scale_sigma = 0.2; },
+      [](ProblemOptions* o) { o->range_calibration.offset_sigma = 2.0; },
+      [](ProblemOptions* o) { o->odometry_calibration.estimate = true; },
+      [](ProblemOptions* o) { o->odometry_calibration.scale_sigma = 0.3; },
+      [](ProblemOptions* o) { o->use_odometry = false; },
+      [](ProblemOptions* o) { o->preintegrate_odometry = false; },
+      [](ProblemOptions* o) { o->max_preintegration_seconds = 2.0; }};
+  for (std::size_t i = 0; i < changes.size(); ++i) {
+    ProblemOptions changed = options.problem;
+    changes[i](&changed);
+    EXPECT_FALSE(problem.BuiltWith(changed)) << "change " << i;
+  }
 }
 
 // Auto's DENSE_SCHUR gives way to the envelope where its factorisation is
