@@ -81,8 +81,12 @@ ceres::LinearSolverType AutoLinearSolverType(const TrajectoryModel& model) {
 }
 
 bool SlamProblem::BuiltWith(const ProblemOptions& o) const {
+  // "auto" builds the Cauchy loss (CreateLoss).
   auto same_loss = [](const LossOptions& a, const LossOptions& b) {
-    return a.name == b.name && a.scale == b.scale;
+    auto built = [](const std::string& name) {
+      return name == "auto" ? std::string("cauchy") : name;
+    };
+    return built(a.name) == built(b.name) && a.scale == b.scale;
   };
   const ProblemOptions& p = options_;
   return same_loss(p.loss, o.loss) &&

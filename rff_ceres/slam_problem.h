@@ -170,7 +170,8 @@ class SlamProblem {
   ceres::Problem* problem() { return problem_.get(); }
   const TrajectoryModel& model() const { return *model_; }
   // Whether the residuals built under `options` are those of this problem:
-  // the same losses, noise scales, odometry and calibrations.
+  // the same losses ("auto" builds Cauchy's), noise scales, odometry and
+  // calibrations.
   bool BuiltWith(const ProblemOptions& options) const;
   // (scale, offset) of the range sensor: (1, 0) unless estimated. Set it
   // before Begin() to start from another value.

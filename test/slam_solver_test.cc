@@ -239,8 +239,14 @@ TEST(SlamProblemTest, BuiltWithTellsEveryResidualOptionApart) {
   ASSERT_NE(model, nullptr) << error;
   const SlamProblem problem(model.get(), options.problem);
   EXPECT_TRUE(problem.BuiltWith(options.problem));
+  // "auto" solves with Cauchy until it is settled: the same residuals.
+  ProblemOptions settled = options.problem;
+  ASSERT_EQ(settled.loss.name, "auto");
+  settled.loss.name = settled.odometry_loss.name = "cauchy";
+  EXPECT_TRUE(problem.BuiltWith(settled));
   const std::vector<std::function<void(ProblemOptions*)>> changes = {
-      [](ProblemOptions* o) { o->loss.name = "cauchy"; },
+      [](ProblemOptions* o) { o->loss.name = "none"; },
+      [](ProblemOptions* o) { o->loss.name = "huber"; },
       [](ProblemOptions* o) { o->loss.scale = 3.0; },
       [](ProblemOptions* o) { o->odometry_loss.name = "none"; },
       [](ProblemOptions* o) { o->odometry_loss.scale = 1.5; },
