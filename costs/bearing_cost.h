@@ -10,6 +10,7 @@
 #include <cmath>
 
 #include "costs/angle.h"
+#include "costs/noise_weighted.h"
 #include "costs/pose_cost.h"
 
 namespace rff {
@@ -32,12 +33,15 @@ inline bool BearingAndGradient(const Eigen::Vector3d& pose,
   return true;
 }
 
-class BearingCost : public PoseCost<1, 1, true> {
+class BearingCost : public PoseCost<1, 1, true>, public ObservationWeighted {
  public:
   BearingCost(PoseMap map, double bearing, double sigma)
       : PoseCost({std::move(map)}),
         bearing_(bearing),
         inv_sigma_(1.0 / sigma) {}
+  void SetSigmas(double /*sigma_range*/, double sigma_bearing) override {
+    inv_sigma_ = 1.0 / sigma_bearing;
+  }
 
  protected:
   bool Residual(const std::array<Eigen::Vector3d, 1>& poses,

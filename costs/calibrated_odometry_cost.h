@@ -24,7 +24,8 @@
 
 namespace rff {
 
-class CalibratedOdometryCost : public ceres::CostFunction {
+class CalibratedOdometryCost : public ceres::CostFunction,
+                               public OdometryWeighted {
  public:
   CalibratedOdometryCost(PoseMap map0, PoseMap map1,
                          const Eigen::Vector3d& motion,
@@ -37,6 +38,10 @@ class CalibratedOdometryCost : public ceres::CostFunction {
     set_num_residuals(3);
     *mutable_parameter_block_sizes() = motion_cost_.parameter_block_sizes();
     mutable_parameter_block_sizes()->push_back(2);  // (s, w)
+  }
+
+  void SetSqrtInformation(const Eigen::Matrix3d& sqrt_information) override {
+    sqrt_information_ = sqrt_information;
   }
 
   bool Evaluate(double const* const* parameters, double* residuals,

@@ -17,6 +17,7 @@
 
 #include "Eigen/Core"
 #include "ceres/cost_function.h"
+#include "costs/noise_weighted.h"
 #include "costs/range_bearing_cost.h"
 #include "costs/range_cost.h"
 
@@ -25,8 +26,14 @@ namespace rff {
 // `Inner` is a cost whose residual 0 is the range residual; it is built with
 // a zero range reading so that residual 0 is |l - p| / sigma.
 template <class Inner>
-class RangeCalibratedCost : public ceres::CostFunction {
+class RangeCalibratedCost : public ceres::CostFunction,
+                            public ObservationWeighted {
  public:
+  void SetSigmas(double sigma_range, double sigma_bearing) override {
+    inner_.SetSigmas(sigma_range, sigma_bearing);
+    inv_sigma_ = 1.0 / sigma_range;
+  }
+
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override {
     const int calibration =

@@ -16,6 +16,7 @@
 
 #include <cmath>
 
+#include "costs/noise_weighted.h"
 #include "costs/pose_cost.h"
 
 namespace rff {
@@ -25,19 +26,27 @@ namespace rff {
 // as a NearLandmarkCost.
 inline constexpr double kNearRangeSigmas = 2.0;
 
-class NearLandmarkCost : public PoseCost<2, 1, true> {
+class NearLandmarkCost : public PoseCost<2, 1, true>,
+                         public ObservationWeighted {
  public:
   // `sigma_range` and `sigma_bearing` weight the rows; the across-ray
   // sigma takes its distance scale from `stated_sigma_range`.
   NearLandmarkCost(PoseMap map, double range, double bearing,
                    double sigma_range, double sigma_bearing,
                    double stated_sigma_range)
-      : PoseCost({std::move(map)}) {
-    const double across = std::hypot(range, stated_sigma_range) * sigma_bearing;
-    const Eigen::Vector2d ray(std::cos(bearing), std::sin(bearing));
+      : PoseCost({std::move(map)}),
+        range_(range),
+        bearing_(bearing),
+        stated_sigma_range_(stated_sigma_range) {
+    SetSigmas(sigma_range, sigma_bearing);
+  }
+  void SetSigmas(double sigma_range, double sigma_bearing) override {
+    const double across =
+        std::hypot(range_, stated_sigma_range_) * sigma_bearing;
+    const Eigen::Vector2d ray(std::cos(bearing_), std::sin(bearing_));
     whitening_.row(0) = ray.transpose() / sigma_range;
     whitening_.row(1) = Eigen::Vector2d(-ray.y(), ray.x()).transpose() / across;
-    offset_ = Eigen::Vector2d(range / sigma_range, 0.0);
+    offset_ = Eigen::Vector2d(range_ / sigma_range, 0.0);
   }
 
  protected:
@@ -61,6 +70,7 @@ class NearLandmarkCost : public PoseCost<2, 1, true> {
   }
 
  private:
+  double range_, bearing_, stated_sigma_range_;
   Eigen::Matrix2d whitening_;  // Rows u^T / sigma_r, u_perp^T / sigma_across.
   Eigen::Vector2d offset_;     // (z_r / sigma_r, 0).
 };

@@ -13,11 +13,12 @@
 #include <cmath>
 
 #include "costs/angle.h"
+#include "costs/noise_weighted.h"
 #include "costs/pose_cost.h"
 
 namespace rff {
 
-class OdometryCost : public PoseCost<3, 2, false> {
+class OdometryCost : public PoseCost<3, 2, false>, public OdometryWeighted {
  public:
   OdometryCost(PoseMap map0, PoseMap map1, const Eigen::Vector3d& motion,
                const Eigen::Matrix3d& sqrt_information)
@@ -29,6 +30,9 @@ class OdometryCost : public PoseCost<3, 2, false> {
                const Eigen::Vector3d& sigma)
       : OdometryCost(std::move(map0), std::move(map1), motion,
                      Eigen::Matrix3d(sigma.cwiseInverse().asDiagonal())) {}
+  void SetSqrtInformation(const Eigen::Matrix3d& sqrt_information) override {
+    sqrt_information_ = sqrt_information;
+  }
 
  protected:
   bool Residual(const std::array<Eigen::Vector3d, 2>& poses,

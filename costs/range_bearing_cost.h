@@ -9,12 +9,14 @@
 
 #include "costs/angle.h"
 #include "costs/bearing_cost.h"
+#include "costs/noise_weighted.h"
 #include "costs/pose_cost.h"
 #include "costs/range_cost.h"
 
 namespace rff {
 
-class RangeBearingCost : public PoseCost<2, 1, true> {
+class RangeBearingCost : public PoseCost<2, 1, true>,
+                         public ObservationWeighted {
  public:
   RangeBearingCost(PoseMap map, double range, double bearing,
                    double sigma_range, double sigma_bearing)
@@ -23,6 +25,10 @@ class RangeBearingCost : public PoseCost<2, 1, true> {
         bearing_(bearing),
         inv_sigma_range_(1.0 / sigma_range),
         inv_sigma_bearing_(1.0 / sigma_bearing) {}
+  void SetSigmas(double sigma_range, double sigma_bearing) override {
+    inv_sigma_range_ = 1.0 / sigma_range;
+    inv_sigma_bearing_ = 1.0 / sigma_bearing;
+  }
 
  protected:
   bool Residual(const std::array<Eigen::Vector3d, 1>& poses,

@@ -9,6 +9,7 @@
 
 #include <cmath>
 
+#include "costs/noise_weighted.h"
 #include "costs/pose_cost.h"
 
 namespace rff {
@@ -28,10 +29,13 @@ inline void RangeAndGradient(const Eigen::Vector3d& pose,
   *d_landmark = u;
 }
 
-class RangeCost : public PoseCost<1, 1, true> {
+class RangeCost : public PoseCost<1, 1, true>, public ObservationWeighted {
  public:
   RangeCost(PoseMap map, double range, double sigma)
       : PoseCost({std::move(map)}), range_(range), inv_sigma_(1.0 / sigma) {}
+  void SetSigmas(double sigma_range, double /*sigma_bearing*/) override {
+    inv_sigma_ = 1.0 / sigma_range;
+  }
 
  protected:
   bool Residual(const std::array<Eigen::Vector3d, 1>& poses,

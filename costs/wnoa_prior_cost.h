@@ -28,6 +28,13 @@ class WnoaPriorCost : public ceres::SizedCostFunction<6, 6, 6> {
   // `dt` > 0 seconds; `qc_*` > 0 the power spectral densities per coordinate.
   WnoaPriorCost(double dt, double qc_x, double qc_y, double qc_theta)
       : dt_(dt) {
+    SetQc(qc_x, qc_y, qc_theta);
+  }
+
+  // The cost the constructor builds with these densities (a learning
+  // round's rescale, in place).
+  void SetQc(double qc_x, double qc_y, double qc_theta) {
+    const double dt = dt_;
     const double qc[3] = {qc_x, qc_y, qc_theta};
     const double inv_dt_sqrt = 1.0 / std::sqrt(dt);
     const double inv_dt_3_2 = inv_dt_sqrt / dt;

@@ -187,12 +187,12 @@ bool LearnScales(const Dataset& dataset,
         CreateTrajectoryModel(dataset, *settled, mean, error);
     if (!rescaled) return false;
     rescaled->AdoptCaches(**model);
-    // The problem as built serves where its residuals are the same and its
-    // costs can follow the new scales in place.
-    const bool in_place = (*problem)->BuiltWith(settled->problem) &&
+    // The problem as built serves where its costs can follow the new
+    // scales in place: the same residuals but for their weights.
+    const bool in_place = (*problem)->CanFollowScales(settled->problem) &&
                           (*model)->AdoptScales(rescaled.get());
     if (in_place) {
-      (*problem)->DropLinearization();
+      (*problem)->FollowScales(settled->problem.noise);
       // As a new model's: the refit below starts from zero.
       SetModelBlocks(std::vector<double>(blocks.size(), 0.0), model->get());
     } else {
@@ -223,11 +223,16 @@ bool LearnScales(const Dataset& dataset,
     final_options.initial_trust_region_radius =
         std::min(reached_radius, ceres_options.max_trust_region_radius);
   }
-  // The model is the last round's: a problem built over it with the same
-  // residuals is the one to solve.
-  return !loose || SolveBatch(dataset, *settled, final_options, model->get(),
-                              landmarks, initial_extent, problem, result, error,
-                              (*problem)->BuiltWith(settled->problem));
+  if (!loose) return true;
+  // The model is the last round's: a problem built over it serves with the
+  // last noise scales given in place.
+  bool reuse = (*problem)->BuiltWith(settled->problem);
+  if (!reuse && (*problem)->CanFollowScales(settled->problem)) {
+    (*problem)->FollowScales(settled->problem.noise);
+    reuse = true;
+  }
+  return SolveBatch(dataset, *settled, final_options, model->get(), landmarks,
+                    initial_extent, problem, result, error, reuse);
 }
 
 }  // namespace rff

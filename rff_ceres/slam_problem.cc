@@ -80,7 +80,10 @@ ceres::LinearSolverType AutoLinearSolverType(const TrajectoryModel& model) {
              : ceres::SPARSE_NORMAL_CHOLESKY;
 }
 
-bool SlamProblem::BuiltWith(const ProblemOptions& o) const {
+namespace {
+
+// Whether problems built under `p` and `o` differ at most in noise scales.
+bool SameButNoise(const ProblemOptions& p, const ProblemOptions& o) {
   // "auto" builds the Cauchy loss (CreateLoss).
   auto same_loss = [](const LossOptions& a, const LossOptions& b) {
     auto built = [](const std::string& name) {
@@ -88,11 +91,8 @@ bool SlamProblem::BuiltWith(const ProblemOptions& o) const {
     };
     return built(a.name) == built(b.name) && a.scale == b.scale;
   };
-  const ProblemOptions& p = options_;
   return same_loss(p.loss, o.loss) &&
          same_loss(p.odometry_loss, o.odometry_loss) &&
-         p.noise.range == o.noise.range && p.noise.bearing == o.noise.bearing &&
-         p.noise.odometry == o.noise.odometry &&
          p.range_calibration.estimate == o.range_calibration.estimate &&
          p.range_calibration.scale_sigma == o.range_calibration.scale_sigma &&
          p.range_calibration.offset_sigma == o.range_calibration.offset_sigma &&
@@ -102,6 +102,32 @@ bool SlamProblem::BuiltWith(const ProblemOptions& o) const {
          p.use_odometry == o.use_odometry &&
          p.preintegrate_odometry == o.preintegrate_odometry &&
          p.max_preintegration_seconds == o.max_preintegration_seconds;
+}
+
+}  // namespace
+
+bool SlamProblem::BuiltWith(const ProblemOptions& o) const {
+  const NoiseScales& n = options_.noise;
+  return SameButNoise(options_, o) && n.range == o.noise.range &&
+         n.bearing == o.noise.bearing && n.odometry == o.noise.odometry;
+}
+
+bool SlamProblem::CanFollowScales(const ProblemOptions& options) const {
+  return built_ && weighted_ && SameButNoise(options_, options);
+}
+
+void SlamProblem::FollowScales(const NoiseScales& noise) {
+  // The products AddObservation and AddOdometry form.
+  for (const ObservationWeights& w : observation_weights_) {
+    w.cost->SetSigmas(noise.range * w.sigma_range,
+                      noise.bearing * w.sigma_bearing);
+  }
+  for (const OdometryWeights& w : odometry_weights_) {
+    w.cost->SetSqrtInformation(w.sqrt_information / noise.odometry);
+  }
+  model_->UpdatePriorCosts(prior_costs_);
+  options_.noise = noise;
+  DropLinearization();
 }
 
 SlamProblem::SlamProblem(TrajectoryModel* model, const ProblemOptions& options)
@@ -131,6 +157,11 @@ void SlamProblem::AddObservation(const Observation& o) {
   }
   const MeasurementType& type = MeasurementTypeOf(o.type);
   ceres::CostFunction* cost = type.cost(o, std::move(map), inputs, &blocks);
+  if (auto* weighted = dynamic_cast<ObservationWeighted*>(cost)) {
+    observation_weights_.push_back({weighted, o.sigma_range, o.sigma_bearing});
+  } else {
+    weighted_ = false;
+  }
   Remember(problem_->AddResidualBlock(cost, loss_.get(), blocks),
            {type.kind, o.t, o.t, o.id, true});
 }
@@ -229,8 +260,8 @@ void SlamProblem::AddOdometry(const PreintegratedOdometry& o) {
   PoseMap map0 = model_->PoseAt(o.t0);
   PoseMap map1 = model_->PoseAt(o.t1);
   std::vector<double*> blocks = LocalBlocks({&map0, &map1}, nullptr);
-  const Eigen::Matrix3d sqrt_information =
-      SqrtInformation(o.covariance) / options_.noise.odometry;
+  const Eigen::Matrix3d stated = SqrtInformation(o.covariance);
+  const Eigen::Matrix3d sqrt_information = stated / options_.noise.odometry;
   ceres::CostFunction* cost = nullptr;
   if (options_.odometry_calibration.estimate) {
     double* calibration = odometry_calibration_.data();
@@ -247,6 +278,11 @@ void SlamProblem::AddOdometry(const PreintegratedOdometry& o) {
   } else {
     cost = new OdometryCost(std::move(map0), std::move(map1), o.motion,
                             sqrt_information);
+  }
+  if (auto* weighted = dynamic_cast<OdometryWeighted*>(cost)) {
+    odometry_weights_.push_back({weighted, stated});
+  } else {
+    weighted_ = false;
   }
   Remember(problem_->AddResidualBlock(cost, odometry_loss_.get(), blocks),
            {"odometry", o.t0, o.t1});
@@ -295,7 +331,16 @@ bool SlamProblem::Build(const Dataset& dataset,
   std::vector<LandmarkId> ids;
   for (const auto& [id, position] : landmarks) ids.push_back(id);
   if (!Begin(ids, error)) return false;
+  const int before = problem_->NumResidualBlocks();
   model_->AddPriorCosts(problem_.get());
+  std::vector<ceres::ResidualBlockId> prior_blocks;
+  problem_->GetResidualBlocks(&prior_blocks);
+  for (std::size_t i = before; i < prior_blocks.size(); ++i) {
+    // The model made them (mutable) and the problem owns them: Ceres hands
+    // them back as const.
+    prior_costs_.push_back(const_cast<ceres::CostFunction*>(
+        problem_->GetCostFunctionForResidualBlock(prior_blocks[i])));
+  }
   for (const auto& [id, position] : landmarks) AddLandmark(id, position);
   for (const PosePrior& p : dataset.pose_priors) AddPosePrior(p);
   for (const LandmarkPrior& p : dataset.landmark_priors) AddLandmarkPrior(p);
@@ -303,6 +348,7 @@ bool SlamProblem::Build(const Dataset& dataset,
   if (!OdometryChains(dataset, options_, &odometry, error)) return false;
   for (const PreintegratedOdometry& o : odometry) AddOdometry(o);
   for (const Observation& o : dataset.observations) AddObservation(o);
+  built_ = true;
   return true;
 }
 

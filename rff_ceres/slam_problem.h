@@ -19,6 +19,7 @@
 #include "ceres/loss_function.h"
 #include "ceres/ordered_groups.h"
 #include "ceres/problem.h"
+#include "costs/noise_weighted.h"
 #include "rff_ceres/banded_problem.h"
 #include "rff_ceres/odometry_preintegration.h"
 #include "rff_ceres/trajectory_model.h"
@@ -173,6 +174,15 @@ class SlamProblem {
   // the same losses ("auto" builds Cauchy's), noise scales, odometry and
   // calibrations.
   bool BuiltWith(const ProblemOptions& options) const;
+  // Whether FollowScales can make this problem the one Build would give
+  // under `options` (which may differ from the problem's in noise scales
+  // only): built whole (Build) with costs that take new weights in place.
+  bool CanFollowScales(const ProblemOptions& options) const;
+  // Gives the data costs the noise scales `noise` and the trajectory
+  // prior's costs the model's current scales (TrajectoryModel::
+  // UpdatePriorCosts), in place, bit for bit as a build would, and drops
+  // the kept linearisation.
+  void FollowScales(const NoiseScales& noise);
   // (scale, offset) of the range sensor: (1, 0) unless estimated. Set it
   // before Begin() to start from another value.
   const Eigen::Vector2d& range_calibration() const {
@@ -280,6 +290,23 @@ class SlamProblem {
 
   TrajectoryModel* model_;
   ProblemOptions options_;
+  // What FollowScales rewrites: each data cost with its stated sigmas or
+  // square-root information (before the noise scales), and the costs the
+  // model's AddPriorCosts added. Set by Build; `weighted_` false where a
+  // cost cannot follow.
+  struct ObservationWeights {
+    ObservationWeighted* cost;
+    double sigma_range, sigma_bearing;
+  };
+  struct OdometryWeights {
+    OdometryWeighted* cost;
+    Eigen::Matrix3d sqrt_information;
+  };
+  std::vector<ObservationWeights> observation_weights_;
+  std::vector<OdometryWeights> odometry_weights_;
+  std::vector<ceres::CostFunction*> prior_costs_;
+  bool weighted_ = true;
+  bool built_ = false;
   // Looked up only, once per residual block in each pass over them.
   std::unordered_map<ceres::ResidualBlockId, Source> sources_;
   // Ceres's own lookup scans every residual (without fast removal).

@@ -86,6 +86,11 @@ class TrajectoryModel {
   // bit and the blocks keep their values. False, nothing changed, where
   // the structure differs or the model cannot (the default).
   virtual bool AdoptScales(TrajectoryModel* /*rescaled*/) { return false; }
+  // Gives `costs`, those AddPriorCosts added to a problem, the prior the
+  // model's scales now say (after AdoptScales): each then equals the cost
+  // AddPriorCosts would add. Nothing where the prior has no scale.
+  virtual void UpdatePriorCosts(
+      const std::vector<ceres::CostFunction*>& /*costs*/) const {}
 };
 
 // Every block's values in block order, and back (same model structure).

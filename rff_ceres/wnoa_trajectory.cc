@@ -222,6 +222,36 @@ void WnoaTrajectory::AdoptCaches(const TrajectoryModel& previous) {
   if (wnoa != nullptr && wnoa->times_ == times_) cache_ = wnoa->cache_;
 }
 
+bool WnoaTrajectory::AdoptScales(TrajectoryModel* rescaled) {
+  const auto* wnoa = dynamic_cast<const WnoaTrajectory*>(rescaled);
+  if (wnoa == nullptr || wnoa->times_ != times_ || wnoa->mean_ != mean_) {
+    return false;
+  }
+  const WnoaOptions& o = wnoa->options_;
+  // The initial-state prior and the states stay as they are.
+  if (o.initial_position_sigma != options_.initial_position_sigma ||
+      o.initial_heading_sigma != options_.initial_heading_sigma ||
+      o.initial_velocity_sigma != options_.initial_velocity_sigma ||
+      o.initial_angular_velocity_sigma !=
+          options_.initial_angular_velocity_sigma ||
+      o.min_state_spacing != options_.min_state_spacing) {
+    return false;
+  }
+  options_.position_qc = o.position_qc;
+  options_.heading_qc = o.heading_qc;
+  return true;
+}
+
+void WnoaTrajectory::UpdatePriorCosts(
+    const std::vector<ceres::CostFunction*>& costs) const {
+  for (ceres::CostFunction* cost : costs) {
+    if (auto* motion = dynamic_cast<WnoaPriorCost*>(cost)) {
+      motion->SetQc(options_.position_qc, options_.position_qc,
+                    options_.heading_qc);
+    }
+  }
+}
+
 PoseMap WnoaTrajectory::PoseAt(double t) const {
   PoseMap map;
   map.mean = mean_->Evaluate(t);

@@ -74,6 +74,12 @@ class WnoaTrajectory : public TrajectoryModel {
   // The interpolations of `previous` where its state times are these (Q_c
   // cancels out of them).
   void AdoptCaches(const TrajectoryModel& previous) override;
+  // Q_c of `rescaled` where its states and mean are these: the
+  // interpolations do not depend on it, the motion prior's costs do
+  // (UpdatePriorCosts).
+  bool AdoptScales(TrajectoryModel* rescaled) override;
+  void UpdatePriorCosts(
+      const std::vector<ceres::CostFunction*>& costs) const override;
   // The initial-state prior on block 0 and one WnoaPriorCost between every
   // pair of consecutive states (a pair belongs to its later state).
   using TrajectoryModel::AddPriorCosts;

@@ -5,6 +5,7 @@
 #include <functional>
 #include <limits>
 #include <map>
+#include <random>
 #include <set>
 
 #include "Eigen/Geometry"
@@ -266,6 +267,81 @@ TEST(SlamProblemTest, BuiltWithTellsEveryResidualOptionApart) {
     changes[i](&changed);
     EXPECT_FALSE(problem.BuiltWith(changed)) << "change " << i;
   }
+}
+
+// A learning round's rescale in place: new noise scales and a new Q_c
+// given to a built WNOA problem make it the problem a build with them
+// gives, every residual and Jacobian entry bit for bit.
+TEST(SlamProblemTest, FollowingScalesGivesTheProblemABuildGives) {
+  const Dataset dataset = PaperDataset(5, 40, 8, 3);
+  ASSERT_FALSE(dataset.odometry.empty());
+  SlamOptions options;
+  options.prior = "wnoa";
+  SlamOptions rescaled_options = options;
+  rescaled_options.wnoa.position_qc *= 0.03;
+  rescaled_options.wnoa.heading_qc *= 7.0;
+  rescaled_options.problem.noise = {0.6, 1.7, 0.4};
+  std::string error;
+  const std::shared_ptr<const MeanFunction> mean =
+      BuildPriorMean("constant", dataset, &error);
+  ASSERT_NE(mean, nullptr) << error;
+  std::map<LandmarkId, Eigen::Vector2d> landmarks;
+  for (const LandmarkPrior& prior : dataset.landmark_priors) {
+    landmarks[prior.id] =
+        Eigen::Vector2d(prior.x, prior.y) + Eigen::Vector2d(0.3, -0.2);
+  }
+  auto model = CreateTrajectoryModel(dataset, options, mean, &error);
+  ASSERT_NE(model, nullptr) << error;
+  std::mt19937 rng(4);
+  std::normal_distribution<double> normal;
+  std::vector<double> values = ModelBlocks(*model);
+  for (double& v : values) v = normal(rng);
+  SetModelBlocks(values, model.get());
+  SlamProblem problem(model.get(), options.problem);
+  ASSERT_TRUE(problem.Build(dataset, landmarks, &error)) << error;
+
+  double cost_before;
+  ASSERT_TRUE(problem.problem()->Evaluate(ceres::Problem::EvaluateOptions(),
+                                          &cost_before, nullptr, nullptr,
+                                          nullptr));
+  auto rescaled =
+      CreateTrajectoryModel(dataset, rescaled_options, mean, &error);
+  ASSERT_NE(rescaled, nullptr) << error;
+  ASSERT_TRUE(problem.CanFollowScales(rescaled_options.problem));
+  ASSERT_TRUE(model->AdoptScales(rescaled.get()));
+  problem.FollowScales(rescaled_options.problem.noise);
+  EXPECT_TRUE(problem.BuiltWith(rescaled_options.problem));
+
+  auto built_model =
+      CreateTrajectoryModel(dataset, rescaled_options, mean, &error);
+  ASSERT_NE(built_model, nullptr) << error;
+  SetModelBlocks(values, built_model.get());
+  SlamProblem built(built_model.get(), rescaled_options.problem);
+  ASSERT_TRUE(built.Build(dataset, landmarks, &error)) << error;
+
+  double cost_a, cost_b;
+  std::vector<double> residuals_a, residuals_b;
+  ceres::CRSMatrix jacobian_a, jacobian_b;
+  ASSERT_TRUE(problem.problem()->Evaluate(ceres::Problem::EvaluateOptions(),
+                                          &cost_a, &residuals_a, nullptr,
+                                          &jacobian_a));
+  ASSERT_TRUE(built.problem()->Evaluate(ceres::Problem::EvaluateOptions(),
+                                        &cost_b, &residuals_b, nullptr,
+                                        &jacobian_b));
+  EXPECT_EQ(cost_a, cost_b);
+  EXPECT_EQ(residuals_a, residuals_b);
+  EXPECT_EQ(jacobian_a.cols, jacobian_b.cols);
+  EXPECT_EQ(jacobian_a.rows, jacobian_b.rows);
+  EXPECT_EQ(jacobian_a.values, jacobian_b.values);
+  EXPECT_GT(std::abs(cost_a - cost_before), 0.01 * cost_before);
+
+  // Another loss is another problem: it is built again.
+  ProblemOptions other_loss = rescaled_options.problem;
+  other_loss.loss.name = "none";
+  EXPECT_FALSE(problem.CanFollowScales(other_loss));
+  // So is one built piece by piece (the incremental mode).
+  SlamProblem pieces(model.get(), options.problem);
+  EXPECT_FALSE(pieces.CanFollowScales(options.problem));
 }
 
 // Auto's DENSE_SCHUR gives way to the envelope where its factorisation is
