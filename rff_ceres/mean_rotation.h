@@ -15,6 +15,7 @@
 #define RFF_CERES_MEAN_ROTATION_H_
 
 #include <memory>
+#include <vector>
 
 #include "rff_ceres/trajectory_model.h"
 
@@ -68,6 +69,11 @@ class MeanRotationTrajectory : public TrajectoryModel {
     return inner_->PriorRowScales(blocks, num_rows);
   }
   void set_mean(std::shared_ptr<const MeanFunction> mean) override;
+  // The rotation's prior has no scale; the inner model's costs follow it.
+  void UpdatePriorCosts(
+      const std::vector<ceres::CostFunction*>& costs) const override {
+    inner_->UpdatePriorCosts(costs);
+  }
 
   TrajectoryModel* inner() { return inner_.get(); }
   const TrajectoryModel* inner() const { return inner_.get(); }

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "Eigen/Geometry"
+#include "costs/wnoa_prior_cost.h"
 #include "gtest/gtest.h"
 #include "rff_ceres/metrics.h"
 #include "rff_ceres/simulate.h"
@@ -103,6 +104,18 @@ TEST(MeanRotationTest, OnlyTheInnerPriorIsRescaledAndDeltaIsShared) {
 // known to 1 mrad, over three seeds (one run varies by 15% either way with
 // the learned noise scales). Measured: 0.212 m known, 0.224 m unknown (WNOA
 // and RFF alike); before the rotation block a turned run ended at 0.54 m.
+// The prior costs a problem holds follow the inner model's scales: a
+// motion prior built with other densities becomes the inner model's own.
+TEST(MeanRotationTest, PriorCostsFollowTheInnerModel) {
+  std::unique_ptr<MeanRotationTrajectory> model = MakeModel(0.5);
+  const WnoaOptions inner;  // MakeModel's.
+  WnoaPriorCost cost(10.0, 5.0, 5.0, 3.0);
+  model->UpdatePriorCosts({&cost});
+  const WnoaPriorCost expected(10.0, inner.position_qc, inner.position_qc,
+                               inner.heading_qc);
+  EXPECT_TRUE(cost.sqrt_information() == expected.sqrt_information());
+}
+
 TEST(MeanRotationTest, UnknownStartHeadingSolvesLikeAKnownOne) {
   std::vector<Dataset> known, turned;
   for (const int seed : {31, 32, 33}) {
