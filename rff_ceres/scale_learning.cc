@@ -226,10 +226,9 @@ bool LearnScales(const Dataset& dataset,
   if (!loose) return true;
   // The model is the last round's: a problem built over it serves with the
   // last noise scales given in place.
-  bool reuse = (*problem)->BuiltWith(settled->problem);
-  if (!reuse && (*problem)->CanFollowScales(settled->problem)) {
+  const bool reuse = (*problem)->CanFollowScales(settled->problem);
+  if (reuse && !(*problem)->BuiltWith(settled->problem)) {
     (*problem)->FollowScales(settled->problem.noise);
-    reuse = true;
   }
   return SolveBatch(dataset, *settled, final_options, model->get(), landmarks,
                     initial_extent, problem, result, error, reuse);

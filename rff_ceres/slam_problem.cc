@@ -113,7 +113,14 @@ bool SlamProblem::BuiltWith(const ProblemOptions& o) const {
 }
 
 bool SlamProblem::CanFollowScales(const ProblemOptions& options) const {
-  return built_ && weighted_ && SameButNoise(options_, options);
+  // Bounded calibration blocks send the solve to Ceres's own minimiser,
+  // which orders an elimination group's blocks by address: a kept problem,
+  // its calibration blocks placed apart from the others, solved to other
+  // last bits than a new one, and not the same from run to run. Those are
+  // built again.
+  const bool calibrated = options_.range_calibration.estimate ||
+                          options_.odometry_calibration.estimate;
+  return built_ && weighted_ && !calibrated && SameButNoise(options_, options);
 }
 
 void SlamProblem::FollowScales(const NoiseScales& noise) {

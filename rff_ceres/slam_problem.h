@@ -176,7 +176,8 @@ class SlamProblem {
   bool BuiltWith(const ProblemOptions& options) const;
   // Whether FollowScales can make this problem the one Build would give
   // under `options` (which may differ from the problem's in noise scales
-  // only): built whole (Build) with costs that take new weights in place.
+  // only): built whole (Build) with costs that take new weights in place,
+  // and no calibration estimated.
   bool CanFollowScales(const ProblemOptions& options) const;
   // Gives the data costs the noise scales `noise` and the trajectory
   // prior's costs the model's current scales (TrajectoryModel::

@@ -339,6 +339,12 @@ TEST(SlamProblemTest, FollowingScalesGivesTheProblemABuildGives) {
   ProblemOptions other_loss = rescaled_options.problem;
   other_loss.loss.name = "none";
   EXPECT_FALSE(problem.CanFollowScales(other_loss));
+  // So is one with a calibration estimated (bounded blocks).
+  ProblemOptions calibrated = options.problem;
+  calibrated.range_calibration.estimate = true;
+  SlamProblem with_calibration(model.get(), calibrated);
+  ASSERT_TRUE(with_calibration.Build(dataset, landmarks, &error)) << error;
+  EXPECT_FALSE(with_calibration.CanFollowScales(calibrated));
   // So is one built piece by piece (the incremental mode).
   SlamProblem pieces(model.get(), options.problem);
   EXPECT_FALSE(pieces.CanFollowScales(options.problem));
