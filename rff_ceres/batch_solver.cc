@@ -114,10 +114,7 @@ bool SolveBatch(const Dataset& dataset, const SlamOptions& options,
                         options.mean.spline_smoothing, error);
     if (!mean) return false;
     model->set_mean(mean);
-    for (int b = 0; b < model->num_blocks(); ++b) {
-      Eigen::Map<Eigen::VectorXd>(model->mutable_block(b), model->block_size(b))
-          .setZero();
-    }
+    ZeroModelBlocks(model);
   }
 }
 

@@ -193,15 +193,16 @@ bool LearnScales(const Dataset& dataset,
                           (*model)->AdoptScales(rescaled.get());
     if (in_place) {
       (*problem)->FollowScales(settled->problem.noise);
-      // As a new model's: the refit below starts from zero.
-      SetModelBlocks(std::vector<double>(blocks.size(), 0.0), model->get());
     } else {
       *model = std::move(rescaled);
     }
     if (!prior.has_features()) {
       SetModelBlocks(blocks, model->get());
-    } else if (!FitModelToPoses(estimate, model->get(), error)) {
-      return false;
+    } else {
+      // From zero, as a new model's weights: a kept model's refit then ends
+      // where a new one's does.
+      ZeroModelBlocks(model->get());
+      if (!FitModelToPoses(estimate, model->get(), error)) return false;
     }
     if (!SolveBatch(dataset, *settled, placing_options, model->get(), landmarks,
                     initial_extent, problem, result, error, in_place)) {

@@ -35,6 +35,12 @@ void SetModelBlocks(const std::vector<double>& values,
   }
 }
 
+void ZeroModelBlocks(TrajectoryModel* model) {
+  for (int b = 0; b < model->num_blocks(); ++b) {
+    std::fill_n(model->mutable_block(b), model->block_size(b), 0.0);
+  }
+}
+
 std::vector<double*> BindPoseMaps(TrajectoryModel* model,
                                   const std::vector<PoseMap*>& maps) {
   std::vector<double*> blocks;

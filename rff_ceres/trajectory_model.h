@@ -96,6 +96,8 @@ class TrajectoryModel {
 // Every block's values in block order, and back (same model structure).
 std::vector<double> ModelBlocks(const TrajectoryModel& model);
 void SetModelBlocks(const std::vector<double>& values, TrajectoryModel* model);
+// Every block to zero: the model is its prior mean, as a new one is.
+void ZeroModelBlocks(TrajectoryModel* model);
 
 // The parameter blocks a cost over `maps` takes, in order of first use; the
 // maps' model block ids are rewritten to indices into that list, in place.
