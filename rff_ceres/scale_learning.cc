@@ -99,6 +99,8 @@ bool LearnScales(const Dataset& dataset,
   std::map<VarianceGroup, Falls> falls;
   std::set<VarianceGroup> kept;  // Noise sigmas back at the stated ones.
   std::set<VarianceGroup> learned;  // Noise factors the data estimated.
+  // Correction variances the data leave at their boundary (at zero).
+  std::set<VarianceGroup> at_boundary;
   const ceres::Solver::Options placing_options = PlacingOptions(ceres_options);
   VarianceComponentCache cache;  // The rounds' problems share one structure.
   // The largest trust radius the solves reached: after rounds, the final
@@ -109,6 +111,7 @@ bool LearnScales(const Dataset& dataset,
   // without learning would.
   double reached_radius = ceres_options.initial_trust_region_radius;
   bool rounds_solved = false;
+  bool problem_stale = false;  // Built over a model since replaced.
   auto note_radius = [&] {
     for (const ceres::IterationSummary& it : result->summary.iterations) {
       reached_radius = std::max(reached_radius, it.trust_region_radius);
@@ -126,10 +129,24 @@ bool LearnScales(const Dataset& dataset,
       break;
     }
     double largest_step = 0.0;
+    const std::size_t boundary_before = at_boundary.size();
     // `power` 1 for a variance, 0.5 for a sigma.
     auto rescale = [&](VarianceGroup group, double power, double* scale) {
       const VarianceComponent& c = components[static_cast<int>(group)];
-      if (!c.estimated || kept.count(group) > 0) return;
+      if (!c.estimated || kept.count(group) > 0 || at_boundary.count(group)) {
+        return;
+      }
+      if (power == 1.0 && prior.has_features() &&
+          c.factor < 1.0 / (kMaxScaleStep * kMaxScaleStep)) {
+        // A correction to the mean whose weights use under 1% of their
+        // variance: its likelihood peaks at zero variance, where the
+        // rounds would walk a tenfold step at a time until the data fix
+        // under min_redundancy of them. One step, and it is learned.
+        *scale /= kMaxScaleStep;
+        at_boundary.insert(group);
+        result->scales_at_boundary.push_back(VarianceGroupName(group));
+        return;
+      }
       const double fall = -std::log(c.factor);
       Falls& f = falls[group];
       // A sigma at its lower bound falls no further: its factors there are
@@ -169,13 +186,21 @@ bool LearnScales(const Dataset& dataset,
         << components[static_cast<int>(VarianceGroup::kPriorPosition)].factor
         << ", heading factor "
         << components[static_cast<int>(VarianceGroup::kPriorHeading)].factor
-        << "; sigma factors range " << sigmas.range << ", bearing "
+        << " (redundancies "
+        << components[static_cast<int>(VarianceGroup::kPriorPosition)]
+               .redundancy
+        << ", "
+        << components[static_cast<int>(VarianceGroup::kPriorHeading)].redundancy
+        << "); sigma factors range " << sigmas.range << ", bearing "
         << sigmas.bearing << ", odometry " << sigmas.odometry;
     result->learning_rounds = round + 1;
     result->prior_scale_factors
         << components[static_cast<int>(VarianceGroup::kPriorPosition)].factor,
         components[static_cast<int>(VarianceGroup::kPriorHeading)].factor;
-    if (largest_step < std::log1p(kScaleTolerance)) {
+    // Every factor but those stepping to the boundary within tolerance.
+    const bool others_settled = largest_step < std::log1p(kScaleTolerance);
+    const bool boundary_step = at_boundary.size() > boundary_before;
+    if (others_settled && !boundary_step) {
       result->learning_converged = true;
       break;
     }
@@ -204,6 +229,16 @@ bool LearnScales(const Dataset& dataset,
       ZeroModelBlocks(model->get());
       if (!FitModelToPoses(estimate, model->get(), error)) return false;
     }
+    if (others_settled) {
+      // Only a boundary step left: the final solve takes it, on a problem
+      // built for the new model where the features followed the variance.
+      problem_stale = !in_place;
+      result->learning_converged = true;
+      rounds_solved = true;
+      result->learned = true;
+      loose = true;
+      break;
+    }
     if (!SolveBatch(dataset, *settled, placing_options, model->get(), landmarks,
                     initial_extent, problem, result, error, in_place)) {
       return false;
@@ -227,7 +262,8 @@ bool LearnScales(const Dataset& dataset,
   if (!loose) return true;
   // The model is the last round's: a problem built over it serves with the
   // last noise scales given in place.
-  const bool reuse = (*problem)->CanFollowScales(settled->problem);
+  const bool reuse =
+      !problem_stale && (*problem)->CanFollowScales(settled->problem);
   if (reuse && !(*problem)->BuiltWith(settled->problem)) {
     (*problem)->FollowScales(settled->problem.noise);
   }

@@ -49,11 +49,16 @@ void PrintSlamSummary(const SlamOptions& options, const SlamResult& result,
   if (result.learning_rounds > 0) {
     *out << "  scales       " << prior.scales_name()
          << " learned by variance components, " << result.learning_rounds
-         << " rounds"
+         << (result.learning_rounds == 1 ? " round" : " rounds")
          << (result.learning_converged
                  ? ""
-                 : " (stopped at the round cap, the factors still moving)")
-         << "\n";
+                 : " (stopped at the round cap, the factors still moving)");
+    const char* separator = "; at zero, the data leave no variance to: ";
+    for (const std::string& group : result.scales_at_boundary) {
+      *out << separator << group;
+      separator = ", ";
+    }
+    *out << "\n";
   }
   if (!result.noise_learned.empty()) {
     *out << "  noise        sigmas learned as the stated ones times:";
@@ -172,6 +177,8 @@ void WriteSummaryJson(const SlamOptions& options, const SlamResult& result,
       << ",\n"
       << "  \"noise_scale_odometry\": " << FormatNumber(result.noise.odometry)
       << ",\n"
+      << "  \"scales_at_boundary\": "
+      << JsonStringArray(result.scales_at_boundary) << ",\n"
       << "  \"noise_scales_kept\": " << JsonStringArray(result.noise_kept)
       << ",\n"
       << "  \"noise_scales_learned\": " << JsonStringArray(result.noise_learned)

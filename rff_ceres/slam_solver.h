@@ -59,6 +59,9 @@ struct SlamResult {
   int learning_rounds = 0;
   // The last round's factors were all within 10% of 1 (not the round cap).
   bool learning_converged = false;
+  // Groups of a correction's variances the data leave at zero (their factor
+  // under 0.01): learned by one step down, no further rounds.
+  std::vector<std::string> scales_at_boundary;
   // Why the scales kept their values although learning was on (the
   // information matrix numerically singular); empty otherwise.
   std::string scales_not_learned;

@@ -1,5 +1,6 @@
 #include "rff_ceres/variance_components.h"
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <memory>
@@ -250,6 +251,60 @@ TEST(VarianceComponentsTest, OdometrySigmaRunningToZeroKeepsTheStatedOne) {
       EXPECT_EQ(summary.str().find("odometry 1\n"), std::string::npos)
           << summary.str();
     }
+  }
+}
+
+// With odometry the RFF weights correct a WNOA solve of the same data,
+// which leaves them nothing to explain: their factors come out far under
+// 0.01 (the likelihood peaks at zero variance). One round takes the tenfold
+// step down and stops, where the rounds walked a step at a time until the
+// data fixed under 10 of the weights. The answer is the WNOA solve's.
+TEST(VarianceComponentsTest, CorrectionTheDataLeaveNoVarianceStopsAtZero) {
+  for (const std::uint64_t seed : {1u, 2u}) {
+    SimulationOptions sim = PaperOptions(seed);
+    sim.num_steps = 300;
+    Dataset dataset;
+    std::string error;
+    ASSERT_TRUE(Simulate(sim, &dataset, &error)) << error;
+    SlamOptions options;
+    options.prior = "rff";
+    SlamResult rff;
+    ASSERT_TRUE(RunSlam(dataset, options, &rff, &error)) << error;
+    ASSERT_EQ(rff.prior_mean, "wnoa");
+    EXPECT_EQ(rff.scales_at_boundary,
+              (std::vector<std::string>{"trajectory position",
+                                        "trajectory heading"}));
+    EXPECT_EQ(rff.learning_rounds, 1);
+    EXPECT_TRUE(rff.learning_converged);
+    EXPECT_LT(rff.prior_scale_factors.maxCoeff(), 0.01);
+    // A tenfold step down from the variance the capacity rule starts at.
+    const FeatureTrajectoryOptions start;
+    EXPECT_DOUBLE_EQ(rff.trajectory_options.position_kernel.variance,
+                     std::pow(2.0 * start.capacity_position_sigma, 2) / 10.0);
+    EXPECT_DOUBLE_EQ(rff.trajectory_options.heading_kernel.variance,
+                     std::pow(2.0 * start.capacity_heading_sigma, 2) / 10.0);
+    std::ostringstream summary;
+    PrintSlamSummary(options, rff, &summary);
+    EXPECT_NE(summary.str().find("1 round; at zero, the data leave no "
+                                 "variance to: trajectory position, "
+                                 "trajectory heading\n"),
+              std::string::npos)
+        << summary.str();
+    options.prior = "wnoa";
+    SlamResult wnoa;
+    ASSERT_TRUE(RunSlam(dataset, options, &wnoa, &error)) << error;
+    ASSERT_EQ(rff.trajectory.size(), wnoa.trajectory.size());
+    double largest = 0.0;
+    for (std::size_t i = 0; i < rff.trajectory.size(); ++i) {
+      largest = std::max(
+          largest, std::hypot(rff.trajectory[i].x - wnoa.trajectory[i].x,
+                              rff.trajectory[i].y - wnoa.trajectory[i].y));
+    }
+    std::printf("seed %llu: factors %.3g %.3g, RFF - WNOA at most %.3g m\n",
+                static_cast<unsigned long long>(seed),
+                rff.prior_scale_factors[0], rff.prior_scale_factors[1],
+                largest);
+    EXPECT_LT(largest, 1e-3);
   }
 }
 
