@@ -18,13 +18,10 @@
 namespace rff {
 namespace {
 
-// Solves whose result only places the next step stop at these relative
-// cost changes: the outlier levels the judging of "auto" losses reads are
-// far coarser; a round's factors are judged at kScaleTolerance, 10%, and
-// what a robust loss's reweighting still gains after a 0.1% step moves the
-// residual sums they are formed from by about 1% (Plaza 1's rounds).
-constexpr double kJudgingTolerance = 1e-4;
-constexpr double kRoundTolerance = 1e-3;
+// Solves whose result only places the next step (the judging of "auto"
+// losses, a round of learned scales) stop at this relative cost change: the
+// factors and outlier levels they feed are far coarser.
+constexpr double kPlacingTolerance = 1e-4;
 
 // The rounds of LearnScales and how far one may move a scale.
 constexpr int kMaxScaleRounds = 12;
@@ -40,11 +37,10 @@ bool HasAutoLoss(const ProblemOptions& options) {
   return options.loss.name == "auto" || options.odometry_loss.name == "auto";
 }
 
-// `ceres_options` stopped at `tolerance` at the latest.
-ceres::Solver::Options PlacingOptions(ceres::Solver::Options ceres_options,
-                                      double tolerance) {
+// `ceres_options` stopped at kPlacingTolerance at the latest.
+ceres::Solver::Options PlacingOptions(ceres::Solver::Options ceres_options) {
   ceres_options.function_tolerance =
-      std::max(ceres_options.function_tolerance, tolerance);
+      std::max(ceres_options.function_tolerance, kPlacingTolerance);
   return ceres_options;
 }
 
@@ -52,8 +48,7 @@ ceres::Solver::Options PlacingOptions(ceres::Solver::Options ceres_options,
 
 ceres::Solver::Options JudgingOptions(const ProblemOptions& options,
                                       ceres::Solver::Options ceres_options) {
-  return HasAutoLoss(options) ? PlacingOptions(ceres_options, kJudgingTolerance)
-                              : ceres_options;
+  return HasAutoLoss(options) ? PlacingOptions(ceres_options) : ceres_options;
 }
 
 bool SettleAutoLosses(SlamProblem* problem, ProblemOptions* options) {
@@ -106,8 +101,7 @@ bool LearnScales(const Dataset& dataset,
   std::set<VarianceGroup> learned;  // Noise factors the data estimated.
   // Correction variances the data leave at their boundary (at zero).
   std::set<VarianceGroup> at_boundary;
-  const ceres::Solver::Options placing_options =
-      PlacingOptions(ceres_options, kRoundTolerance);
+  const ceres::Solver::Options placing_options = PlacingOptions(ceres_options);
   VarianceComponentCache cache;  // The rounds' problems share one structure.
   // The largest trust radius the solves reached: after rounds, the final
   // solve goes on from their point on their problem but for a rescale, so

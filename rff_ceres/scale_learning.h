@@ -18,7 +18,7 @@
 
 namespace rff {
 
-// The robust solve that judges "auto" losses stops at kJudgingTolerance: the
+// The robust solve that judges "auto" losses stops at kPlacingTolerance: the
 // judgement compares residuals with an outlier level of several sigma; the
 // solve after it finishes.
 ceres::Solver::Options JudgingOptions(const ProblemOptions& options,
@@ -35,13 +35,10 @@ bool SettleAutoLosses(SlamProblem* problem, ProblemOptions* options);
 // of range, bearing and odometry: after the first MAP, each round rescales
 // the variances by their variance-component factors (variance_components.h,
 // the fixed point of the Laplace evidence) and solves again from the current
-// estimate (to kRoundTolerance), until every factor is within
-// kScaleTolerance of one. The data's
+// estimate, until every factor is within kScaleTolerance of one. The data's
 // stated sigmas are often a guess: MRCLAM's bearings and odometry are
 // several times tighter than stated (docs/heldout.md). `loose`: the problem
-// was solved at kJudgingTolerance only. A correction whose factor is under
-// 0.01 (its variance at zero, as far as the data tell) takes one tenfold
-// step down and is learned no further.
+// was solved at kPlacingTolerance only.
 bool LearnScales(const Dataset& dataset,
                  std::shared_ptr<const MeanFunction> mean,
                  const ceres::Solver::Options& ceres_options,
