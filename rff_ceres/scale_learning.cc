@@ -130,6 +130,8 @@ bool LearnScales(const Dataset& dataset,
     }
     double largest_step = 0.0;
     const std::size_t boundary_before = at_boundary.size();
+    const double position_solved = *position_scale;
+    const double heading_solved = *heading_scale;
     // `power` 1 for a variance, 0.5 for a sigma.
     auto rescale = [&](VarianceGroup group, double power, double* scale) {
       const VarianceComponent& c = components[static_cast<int>(group)];
@@ -201,6 +203,11 @@ bool LearnScales(const Dataset& dataset,
     const bool others_settled = largest_step < std::log1p(kScaleTolerance);
     const bool boundary_step = at_boundary.size() > boundary_before;
     if (others_settled && !boundary_step) {
+      // Within tolerance: the prior keeps the scales it was solved with, so
+      // that those reported are those the final solve uses (the noise
+      // scales it takes in place).
+      *position_scale = position_solved;
+      *heading_scale = heading_solved;
       result->learning_converged = true;
       break;
     }
