@@ -62,14 +62,6 @@ int main(int argc, char** argv) {
     options.start_heading_sigma = FLAGS_start_heading_sigma;
   }
   options.seed = FLAGS_seed;
-  if (!rff::ValidatePerturbOptions(options, &error)) return Fail(error);
-  // A copy under another name would pass for a perturbed file.
-  if (!rff::ChangesLandmarkPriors(options) &&
-      !rff::ChangesStartHeading(options)) {
-    return Fail(
-        "nothing to perturb: give --landmark_prior_offset, "
-        "--start_heading_offset_deg or --start_heading_sigma");
-  }
   if (!rff::PerturbFile(FLAGS_input, FLAGS_output, options, &error)) {
     return Fail(error);
   }

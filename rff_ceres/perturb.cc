@@ -128,6 +128,13 @@ bool PerturbDataset(const PerturbOptions& options, Dataset* dataset,
 bool PerturbFile(const std::string& input, const std::string& output,
                  const PerturbOptions& options, std::string* error) {
   if (!ValidatePerturbOptions(options, error)) return false;
+  // A copy under another name would pass for a perturbed file.
+  if (!ChangesLandmarkPriors(options) && !ChangesStartHeading(options)) {
+    *error =
+        "nothing to perturb: give --landmark_prior_offset, "
+        "--start_heading_offset_deg or --start_heading_sigma";
+    return false;
+  }
   if (SameFile(input, output)) {
     *error = OptionError("output", output,
                          "the same file as the input --input=" + input,

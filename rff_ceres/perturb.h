@@ -49,10 +49,10 @@ bool ChangesStartHeading(const PerturbOptions& options);
 bool PerturbDataset(const PerturbOptions& options, Dataset* dataset,
                     std::string* error);
 
-// Reads `input` (.rffd), perturbs it and writes `output`. Refuses an output
-// that is the input (the same path or the same file) before reading
-// anything, and writes nothing on any error; errors about the dataset are
-// prefixed with the input path.
+// Reads `input` (.rffd), perturbs it and writes `output`. Refuses options
+// that change nothing and an output that is the input (the same path or the
+// same file) before reading anything, and writes nothing on any error;
+// errors about the dataset are prefixed with the input path.
 bool PerturbFile(const std::string& input, const std::string& output,
                  const PerturbOptions& options, std::string* error);
 

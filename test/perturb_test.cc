@@ -292,6 +292,8 @@ TEST(PerturbFileTest, RefusesBadFilesAndWritesNothing) {
   const std::string original = testing::ReadFile(dir + "/in.rffd");
   PerturbOptions offset;
   offset.landmark_prior_offset = 1.0;
+  PerturbOptions turn;
+  turn.start_heading_offset_deg = 90.0;
   struct Case {
     std::string input, output;
     PerturbOptions options;
@@ -311,9 +313,13 @@ TEST(PerturbFileTest, RefusesBadFilesAndWritesNothing) {
              "priors, but there is no PRIOR_LANDMARK record"},
       {dir + "/in.rffd", dir + "/out.rffd", PerturbOptions{-2.0, 0.0, {}, 1},
        "--landmark_prior_offset=-2: allowed 0 to 1e+06 m"},
-      {dir + "/in.rffd", dir + "/no/such/dir/out.rffd", PerturbOptions(),
+      {dir + "/in.rffd", dir + "/no/such/dir/out.rffd", turn,
        dir + "/no/such/dir/out.rffd: cannot open for writing: No such file "
              "or directory"},
+      // A copy under another name would pass for a perturbed file.
+      {dir + "/none.rffd", dir + "/out.rffd", PerturbOptions(),
+       "nothing to perturb: give --landmark_prior_offset, "
+       "--start_heading_offset_deg or --start_heading_sigma"},
   };
   for (const Case& c : cases) {
     error.clear();
