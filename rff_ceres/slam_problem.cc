@@ -39,6 +39,15 @@ double NoiseScale(const NoiseScales& noise, VarianceGroup group) {
   }
 }
 
+namespace {
+
+// The loss a name builds: "auto" is Cauchy's until its judging settles it.
+std::string BuiltLossName(const std::string& name) {
+  return name == "auto" ? std::string("cauchy") : name;
+}
+
+}  // namespace
+
 bool CreateLoss(const LossOptions& options, const std::string& flag,
                 std::unique_ptr<ceres::LossFunction>* loss,
                 std::string* error) {
@@ -56,10 +65,11 @@ bool CreateLoss(const LossOptions& options, const std::string& flag,
                              FormatNumber(kMaxLossScale) + " sigmas");
     return false;
   }
-  if (options.name == "none") return true;
-  if (options.name == "huber") {
+  const std::string built = BuiltLossName(options.name);
+  if (built == "none") return true;
+  if (built == "huber") {
     loss->reset(new ceres::HuberLoss(options.scale));
-  } else if (options.name == "cauchy" || options.name == "auto") {
+  } else if (built == "cauchy") {
     loss->reset(new ceres::CauchyLoss(options.scale));
   } else {
     *error = OptionError(flag, options.name, "unknown loss",
@@ -84,12 +94,8 @@ namespace {
 
 // Whether problems built under `p` and `o` differ at most in noise scales.
 bool SameButNoise(const ProblemOptions& p, const ProblemOptions& o) {
-  // "auto" builds the Cauchy loss (CreateLoss).
   auto same_loss = [](const LossOptions& a, const LossOptions& b) {
-    auto built = [](const std::string& name) {
-      return name == "auto" ? std::string("cauchy") : name;
-    };
-    return built(a.name) == built(b.name) && a.scale == b.scale;
+    return BuiltLossName(a.name) == BuiltLossName(b.name) && a.scale == b.scale;
   };
   return same_loss(p.loss, o.loss) &&
          same_loss(p.odometry_loss, o.odometry_loss) &&
