@@ -161,7 +161,7 @@ class BandedProblem {
 // a solve leaves them: the variance components and the convergence check
 // factorise that H rather than linearising the same point again.
 struct BandedLinearization {
-  std::unique_ptr<BandedProblem> banded;
+  std::shared_ptr<BandedProblem> banded;
   Eigen::VectorXd x, gradient;
   std::unique_ptr<EnvelopeMatrix> hessian;
 };

@@ -202,7 +202,7 @@ bool RunSolve(const SolverOptions& solver, ceres::Solver::Options ceres_options,
            ceres::LEVENBERG_MARQUARDT)) {
     const BandedColumns columns = problem->BandColumns();
     std::string why;
-    std::unique_ptr<BandedProblem> banded;
+    std::shared_ptr<BandedProblem> banded;
     if (!BandedSolvable(*problem->problem(), columns, &why)) {
       // The only bounded blocks here.
       if (why == "a parameter has bounds") {
@@ -211,7 +211,7 @@ bool RunSolve(const SolverOptions& solver, ceres::Solver::Options ceres_options,
             "--estimate_odometry_calibration have)";
       }
     } else {
-      banded = std::make_unique<BandedProblem>(*problem->problem(), columns);
+      banded = problem->BandedLayout(columns);
       const BandedSize size = banded->Size();
       // The envelope three times: H, the candidate step's H and the
       // factor of the damped system.

@@ -183,8 +183,7 @@ bool FactorizeBanded(SlamProblem* problem, BandedSystem* system) {
   const BandedColumns columns = problem->BandColumns();
   std::string why;
   if (!BandedSolvable(*problem->problem(), columns, &why)) return false;
-  system->banded =
-      std::make_unique<BandedProblem>(*problem->problem(), columns);
+  system->banded = problem->BandedLayout(columns);
   BandedProblem& banded = *system->banded;
   if (!EnvelopeAffordable(banded.Size())) return false;
   system->x = banded.Gather();

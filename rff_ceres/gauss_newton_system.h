@@ -136,7 +136,7 @@ class GaussNewtonSystem {
 // (features) and where the envelope does not serve (bounds, manifolds, too
 // costly, or H not positive definite to rounding).
 struct BandedSystem {
-  std::unique_ptr<BandedProblem> banded;
+  std::shared_ptr<BandedProblem> banded;
   Eigen::VectorXd x, gradient;
   std::unique_ptr<EnvelopeMatrix> factor;
 };

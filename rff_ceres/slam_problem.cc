@@ -576,17 +576,32 @@ bool SlamProblem::BlockState::operator==(const BlockState& other) const {
                                         values.size() * sizeof(double)) == 0);
 }
 
-SlamProblem::BlockState SlamProblem::CurrentBlockState() const {
+SlamProblem::BlockState SlamProblem::CurrentBlockState(bool with_values) const {
   BlockState state;
   state.num_residual_blocks = problem_->NumResidualBlocks();
   std::vector<double*> blocks;
   problem_->GetParameterBlocks(&blocks);
   for (double* block : blocks) {
     state.blocks.emplace_back(block, problem_->IsParameterBlockConstant(block));
+    if (!with_values) continue;
     const int size = problem_->ParameterBlockSize(block);
     state.values.insert(state.values.end(), block, block + size);
   }
   return state;
+}
+
+std::shared_ptr<BandedProblem> SlamProblem::BandedLayout(
+    const BandedColumns& columns) {
+  BlockState state = CurrentBlockState(/*with_values=*/false);
+  if (!layout_ || !(state == layout_state_) ||
+      columns.timed != layout_columns_.timed ||
+      columns.placed != layout_columns_.placed ||
+      columns.last != layout_columns_.last) {
+    layout_ = std::make_shared<BandedProblem>(*problem_, columns);
+    layout_state_ = std::move(state);
+    layout_columns_ = columns;
+  }
+  return layout_;
 }
 
 void SlamProblem::KeepLinearization(BandedLinearization linearization) {

@@ -240,6 +240,12 @@ class SlamProblem {
   // trajectory blocks in the model's (time) order, the landmarks each placed
   // after its sightings, the shared blocks and calibrations last.
   BandedColumns BandColumns();
+  // The problem laid out on `columns` (its BandColumns()) for
+  // BANDED_CHOLESKY: the last layout while the residual blocks' count, the
+  // parameter blocks (each as constant or not) and `columns` are those it
+  // was made for, as the costs take new weights in place between learning
+  // rounds; a new one otherwise.
+  std::shared_ptr<BandedProblem> BandedLayout(const BandedColumns& columns);
   // What the last BANDED_CHOLESKY solve left (RunSolve): its layout and
   // its linearisation at the values it wrote back, for FactorizeBanded.
   void KeepLinearization(BandedLinearization linearization);
@@ -263,7 +269,7 @@ class SlamProblem {
     std::vector<double> values;
     bool operator==(const BlockState& other) const;  // Values bit for bit.
   };
-  BlockState CurrentBlockState() const;
+  BlockState CurrentBlockState(bool with_values = true) const;
   // Parameter blocks of a cost over `maps` (model block ids rewritten to the
   // cost's local indices, in place), with `landmark` appended if non-null.
   std::vector<double*> LocalBlocks(std::vector<PoseMap*> maps,
@@ -321,6 +327,9 @@ class SlamProblem {
   std::vector<Eigen::Vector2d> storage_;
   BandedLinearization kept_;
   BlockState kept_state_;
+  std::shared_ptr<BandedProblem> layout_;
+  BlockState layout_state_;  // Without values.
+  BandedColumns layout_columns_;
   std::set<LandmarkId> added_;
   std::set<LandmarkId> has_prior_;
   Eigen::Vector2d range_calibration_ = Eigen::Vector2d(1.0, 0.0);

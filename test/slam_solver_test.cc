@@ -304,6 +304,8 @@ TEST(SlamProblemTest, FollowingScalesGivesTheProblemABuildGives) {
   ASSERT_TRUE(problem.problem()->Evaluate(ceres::Problem::EvaluateOptions(),
                                           &cost_before, nullptr, nullptr,
                                           nullptr));
+  const std::shared_ptr<BandedProblem> layout =
+      problem.BandedLayout(problem.BandColumns());
   auto rescaled =
       CreateTrajectoryModel(dataset, rescaled_options, mean, &error);
   ASSERT_NE(rescaled, nullptr) << error;
@@ -334,6 +336,29 @@ TEST(SlamProblemTest, FollowingScalesGivesTheProblemABuildGives) {
   EXPECT_EQ(jacobian_a.rows, jacobian_b.rows);
   EXPECT_EQ(jacobian_a.values, jacobian_b.values);
   EXPECT_GT(std::abs(cost_a - cost_before), 0.01 * cost_before);
+
+  // Its banded layout is kept, and linearises as a new one on the build.
+  EXPECT_EQ(problem.BandedLayout(problem.BandColumns()), layout);
+  BandedProblem laid_out(*built.problem(), built.BandColumns());
+  EnvelopeMatrix h_kept(layout->envelope_first()),
+      h_built(laid_out.envelope_first());
+  Eigen::VectorXd g_kept, g_built;
+  ASSERT_TRUE(layout->Linearize(layout->Gather(), &cost_a, &g_kept, &h_kept));
+  ASSERT_TRUE(
+      laid_out.Linearize(laid_out.Gather(), &cost_b, &g_built, &h_built));
+  EXPECT_EQ(cost_a, cost_b);
+  EXPECT_EQ(g_kept, g_built);
+  ASSERT_EQ(h_kept.num_entries(), h_built.num_entries());
+  for (int i = 0; i < h_kept.size(); ++i) {
+    for (int j = h_kept.first(i); j <= i; ++j) {
+      ASSERT_EQ(h_kept(i, j), h_built(i, j)) << i << ", " << j;
+    }
+  }
+  // A block held constant is another layout.
+  std::vector<double*> blocks;
+  problem.problem()->GetParameterBlocks(&blocks);
+  problem.problem()->SetParameterBlockConstant(blocks.front());
+  EXPECT_NE(problem.BandedLayout(problem.BandColumns()), layout);
 
   // Another loss is another problem: it is built again.
   ProblemOptions other_loss = rescaled_options.problem;
