@@ -400,7 +400,9 @@ std::map<std::string, std::vector<double>> SlamProblem::WhitenedResidualsByKind(
     for (std::size_t row = 0; stated_sigmas && row < residuals.size();
          ++row) {
       residuals[row] *= NoiseScale(
-          options_.noise, DataRowGroup(name, static_cast<int>(row)));
+          options_.noise, source == sources_.end()
+                              ? VarianceGroup::kFixed
+                              : source->second.RowGroup(static_cast<int>(row)));
     }
     std::vector<double>& kind = by_kind[name];
     kind.insert(kind.end(), residuals.begin(), residuals.end());
@@ -520,7 +522,7 @@ std::vector<VarianceGroup> SlamProblem::RowGroups(
       continue;
     }
     for (int row = 0; row < n; ++row) {
-      rows.push_back(DataRowGroup(source->second.kind, row));
+      rows.push_back(source->second.RowGroup(row));
     }
   }
   return rows;

@@ -282,6 +282,13 @@ class SlamProblem {
     LandmarkId landmark = 0;
     bool has_landmark = false;
     bool has_time = true;  // Priors on landmarks and calibrations have none.
+    // DataRowGroup of its first row and of the others, set by Remember:
+    // looked up per row by every round's variance components.
+    VarianceGroup first_row = VarianceGroup::kFixed;
+    VarianceGroup later_rows = VarianceGroup::kFixed;
+    VarianceGroup RowGroup(int row) const {
+      return row == 0 ? first_row : later_rows;
+    }
   };
   std::string Describe(ceres::ResidualBlockId id) const;
   // A calibration block `values` under the prior N(mean, diag(sigma^2)) (a
@@ -290,7 +297,9 @@ class SlamProblem {
                       const Eigen::Vector2d& sigma,
                       const Eigen::Vector2d& lower,
                       const Eigen::Vector2d& upper, double* values);
-  void Remember(ceres::ResidualBlockId id, const Source& source) {
+  void Remember(ceres::ResidualBlockId id, Source source) {
+    source.first_row = DataRowGroup(source.kind, 0);
+    source.later_rows = DataRowGroup(source.kind, 1);
     sources_[id] = source;
     if (source.has_landmark) landmark_residuals_[source.landmark].push_back(id);
   }
