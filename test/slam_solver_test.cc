@@ -19,12 +19,14 @@
 #include "rff_ceres/priors/trajectory_prior.h"
 #include "rff_ceres/simulate.h"
 #include "test/synthetic_options.h"
+#include "test/trajectory_difference.h"
 
 namespace rff {
 namespace {
 
 using ::testing::EndsWith;
 using ::testing::HasSubstr;
+using testing::LargestPositionDifference;
 using ::testing::StartsWith;
 
 // Options that work on the paper's simulated protocol (300 s, 1 Hz).
@@ -44,21 +46,6 @@ Dataset PaperDataset(std::uint64_t seed, int steps, int landmarks,
   std::string error;
   EXPECT_TRUE(Simulate(sim, &dataset, &error)) << error;
   return dataset;
-}
-
-// The largest difference of x or y between two solves' trajectories (the
-// same times); infinity if they differ in length.
-double LargestPositionDifference(const SlamResult& a, const SlamResult& b) {
-  if (a.trajectory.size() != b.trajectory.size()) {
-    return std::numeric_limits<double>::infinity();
-  }
-  double largest = 0.0;
-  for (std::size_t i = 0; i < a.trajectory.size(); ++i) {
-    largest =
-        std::max({largest, std::abs(a.trajectory[i].x - b.trajectory[i].x),
-                  std::abs(a.trajectory[i].y - b.trajectory[i].y)});
-  }
-  return largest;
 }
 
 // `options` solved with BANDED_CHOLESKY and with Ceres's sparse Cholesky.

@@ -24,6 +24,7 @@
 #include "rff_ceres/simulate.h"
 #include "rff_ceres/slam_report.h"
 #include "rff_ceres/slam_solver.h"
+#include "test/trajectory_difference.h"
 
 namespace rff {
 namespace {
@@ -136,13 +137,7 @@ TEST(VarianceComponentsTest, ReportedScalesReproduceTheSolve) {
   options.problem.noise = learned.noise;
   SlamResult given;
   ASSERT_TRUE(RunSlam(dataset, options, &given, &error)) << error;
-  ASSERT_EQ(given.trajectory.size(), learned.trajectory.size());
-  double largest = 0.0;
-  for (std::size_t i = 0; i < given.trajectory.size(); ++i) {
-    largest = std::max(
-        largest, std::hypot(given.trajectory[i].x - learned.trajectory[i].x,
-                            given.trajectory[i].y - learned.trajectory[i].y));
-  }
+  const double largest = testing::LargestPositionDifference(given, learned);
   std::printf("largest difference %.3g m\n", largest);
   EXPECT_LT(largest, 1e-4);
 }
@@ -323,13 +318,7 @@ TEST(VarianceComponentsTest, CorrectionTheDataLeaveNoVarianceStopsAtZero) {
     options.prior = "wnoa";
     SlamResult wnoa;
     ASSERT_TRUE(RunSlam(dataset, options, &wnoa, &error)) << error;
-    ASSERT_EQ(rff.trajectory.size(), wnoa.trajectory.size());
-    double largest = 0.0;
-    for (std::size_t i = 0; i < rff.trajectory.size(); ++i) {
-      largest = std::max(
-          largest, std::hypot(rff.trajectory[i].x - wnoa.trajectory[i].x,
-                              rff.trajectory[i].y - wnoa.trajectory[i].y));
-    }
+    const double largest = testing::LargestPositionDifference(rff, wnoa);
     std::printf("seed %llu: factors %.3g %.3g, RFF - WNOA at most %.3g m\n",
                 static_cast<unsigned long long>(seed),
                 rff.prior_scale_factors[0], rff.prior_scale_factors[1],
