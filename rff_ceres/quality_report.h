@@ -51,7 +51,7 @@ struct ResidualKindQuality {
 
 struct QualityReport {
   std::vector<ResidualKindQuality> kinds;  // Sorted by kind.
-  std::string verdict = "ok";              // "ok" or "suspect"
+  std::string verdict = "ok";              // "ok", "suspect" or "not judged"
   std::vector<std::string> reasons;        // Why "suspect", one line each.
   double predicted_decrease = 0.0;         // SolveFacts's, NaN if unknown.
   bool suspect() const { return verdict != "ok"; }

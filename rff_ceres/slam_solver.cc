@@ -169,14 +169,19 @@ bool ReportSolution(const SlamOptions& options,
   result->wnoa_options = settled->wnoa;
   PriorOf(options).RecordModel(model, result);
   if (!problem->CheckLandmarksDetermined(1e12, error)) return false;
-  // Judged against the data as stated: learned sigmas would absorb a misfit.
-  SolveFacts facts = SolveFactsOf(*settled, *result);
-  facts.predicted_decrease =
-      options.incremental.every == 0
-          ? GaussNewtonDecrease(problem, &facts.predicted_decrease_exact)
-          : std::numeric_limits<double>::quiet_NaN();
-  result->quality = AssessQuality(
-      problem->WhitenedResidualsByKind(/*stated_sigmas=*/true), facts);
+  if (options.output.quality) {
+    // Judged against the data as stated: learned sigmas would absorb a
+    // misfit.
+    SolveFacts facts = SolveFactsOf(*settled, *result);
+    facts.predicted_decrease =
+        options.incremental.every == 0
+            ? GaussNewtonDecrease(problem, &facts.predicted_decrease_exact)
+            : std::numeric_limits<double>::quiet_NaN();
+    result->quality = AssessQuality(
+        problem->WhitenedResidualsByKind(/*stated_sigmas=*/true), facts);
+  } else {
+    result->quality.verdict = "not judged";  // Not the default "ok".
+  }
   for (const auto& [id, position] : landmarks) {
     Landmark l;
     l.id = id;

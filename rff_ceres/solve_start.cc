@@ -24,6 +24,7 @@ bool SolveWnoa(const Dataset& dataset, const SlamOptions& options,
   wnoa.mean.name = "auto";
   wnoa.mean.outer_rounds = 0;
   wnoa.output.covariance = covariance;
+  wnoa.output.quality = false;
   // The user's linear solver is for the RFF solve; banded states want their
   // own (AutoLinearSolverType).
   wnoa.solver.linear_solver = "auto";

@@ -98,6 +98,25 @@ TEST(SlamSolverTest, RangeBearingWithOdometryBeatsDeadReckoningByFar) {
       << errors[0] << " " << errors[1] << " " << errors[2];
 }
 
+// The WNOA solve an RFF prior's mean comes from skips the quality verdict
+// (the RFF solve judges its own): without it, the verdict says it was not
+// judged rather than the default "ok"; the solve is the same.
+TEST(SlamSolverTest, QualityOffSaysNotJudged) {
+  const Dataset dataset = PaperDataset(5, 40, 8, 3);
+  SlamOptions options;
+  options.prior = "wnoa";
+  SlamResult judged, unjudged;
+  std::string error;
+  ASSERT_TRUE(RunSlam(dataset, options, &judged, &error)) << error;
+  options.output.quality = false;
+  ASSERT_TRUE(RunSlam(dataset, options, &unjudged, &error)) << error;
+  EXPECT_EQ(judged.quality.verdict, "ok");
+  EXPECT_FALSE(judged.quality.kinds.empty());
+  EXPECT_EQ(unjudged.quality.verdict, "not judged");
+  EXPECT_TRUE(unjudged.quality.kinds.empty());
+  EXPECT_EQ(LargestPositionDifference(judged, unjudged), 0.0);
+}
+
 // A minute without observations in a 300 s range-bearing run: the WNOA
 // prior about a constant mean keeps a state at each end of every odometry
 // residual and starts from dead reckoning, so the solve follows the
