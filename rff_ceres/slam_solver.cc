@@ -166,7 +166,11 @@ bool ReportSolution(const SlamOptions& options,
   }
   result->loss = settled->problem.loss.name;
   result->odometry_loss = settled->problem.odometry_loss.name;
-  result->wnoa_options = settled->wnoa;
+  // An RFF prior about a WNOA solve reports the Q_c that solve learned, not
+  // its own unused WNOA options.
+  result->wnoa_options = wnoa_mean_solve.trajectory.empty()
+                             ? settled->wnoa
+                             : wnoa_mean_solve.wnoa_options;
   PriorOf(options).RecordModel(model, result);
   if (!problem->CheckLandmarksDetermined(1e12, error)) return false;
   if (options.output.quality) {

@@ -319,6 +319,10 @@ TEST(VarianceComponentsTest, CorrectionTheDataLeaveNoVarianceStopsAtZero) {
     SlamResult wnoa;
     ASSERT_TRUE(RunSlam(dataset, options, &wnoa, &error)) << error;
     const double largest = testing::LargestPositionDifference(rff, wnoa);
+    // Its summary's Q_c is the one its WNOA mean learned.
+    EXPECT_EQ(rff.wnoa_options.position_qc, wnoa.wnoa_options.position_qc);
+    EXPECT_EQ(rff.wnoa_options.heading_qc, wnoa.wnoa_options.heading_qc);
+    EXPECT_NE(rff.wnoa_options.position_qc, WnoaOptions().position_qc);
     std::printf("seed %llu: factors %.3g %.3g, RFF - WNOA at most %.3g m\n",
                 static_cast<unsigned long long>(seed),
                 rff.prior_scale_factors[0], rff.prior_scale_factors[1],
