@@ -26,6 +26,9 @@ namespace rff {
 // blocks).
 struct BandedColumns {
   std::vector<double*> timed, placed, last;
+  bool operator==(const BandedColumns& other) const {
+    return timed == other.timed && placed == other.placed && last == other.last;
+  }
 };
 
 // The blocks of `columns` in the system's column order (as above), placed

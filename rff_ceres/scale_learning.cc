@@ -111,7 +111,6 @@ bool LearnScales(const Dataset& dataset,
   // without learning would.
   double reached_radius = ceres_options.initial_trust_region_radius;
   bool rounds_solved = false;
-  bool problem_stale = false;  // Built over a model since replaced.
   auto note_radius = [&] {
     for (const ceres::IterationSummary& it : result->summary.iterations) {
       reached_radius = std::max(reached_radius, it.trust_region_radius);
@@ -236,14 +235,15 @@ bool LearnScales(const Dataset& dataset,
       ZeroModelBlocks(model->get());
       if (!FitModelToPoses(estimate, model->get(), error)) return false;
     }
+    rounds_solved = true;
+    result->learned = true;
+    loose = true;
     if (others_settled) {
       // Only a boundary step left: the final solve takes it, on a problem
-      // built for the new model where the features followed the variance.
-      problem_stale = !in_place;
+      // built anew where the features followed the variance (the old one
+      // holds costs of the model replaced).
+      if (!in_place) problem->reset();
       result->learning_converged = true;
-      rounds_solved = true;
-      result->learned = true;
-      loose = true;
       break;
     }
     if (!SolveBatch(dataset, *settled, placing_options, model->get(), landmarks,
@@ -251,9 +251,6 @@ bool LearnScales(const Dataset& dataset,
       return false;
     }
     note_radius();
-    rounds_solved = true;
-    result->learned = true;
-    loose = true;
   }
   for (const VarianceGroup group : learned) {
     if (kept.count(group) == 0) {
@@ -270,7 +267,7 @@ bool LearnScales(const Dataset& dataset,
   // The model is the last round's: a problem built over it serves with the
   // last noise scales given in place.
   const bool reuse =
-      !problem_stale && (*problem)->CanFollowScales(settled->problem);
+      *problem != nullptr && (*problem)->CanFollowScales(settled->problem);
   if (reuse && !(*problem)->BuiltWith(settled->problem)) {
     (*problem)->FollowScales(settled->problem.noise);
   }

@@ -595,10 +595,7 @@ SlamProblem::BlockState SlamProblem::CurrentBlockState(bool with_values) const {
 std::shared_ptr<BandedProblem> SlamProblem::BandedLayout(
     const BandedColumns& columns) {
   BlockState state = CurrentBlockState(/*with_values=*/false);
-  if (!layout_ || !(state == layout_state_) ||
-      columns.timed != layout_columns_.timed ||
-      columns.placed != layout_columns_.placed ||
-      columns.last != layout_columns_.last) {
+  if (!layout_ || !(state == layout_state_) || !(columns == layout_columns_)) {
     layout_ = std::make_shared<BandedProblem>(*problem_, columns);
     layout_state_ = std::move(state);
     layout_columns_ = columns;
