@@ -223,7 +223,7 @@ bool LearnScales(const Dataset& dataset,
     const bool in_place = (*problem)->CanFollowScales(settled->problem) &&
                           (*model)->AdoptScales(rescaled.get());
     if (in_place) {
-      (*problem)->FollowScales(settled->problem.noise);
+      (*problem)->FollowScales(settled->problem);
     } else {
       *model = std::move(rescaled);
     }
@@ -269,7 +269,7 @@ bool LearnScales(const Dataset& dataset,
   const bool reuse =
       *problem != nullptr && (*problem)->CanFollowScales(settled->problem);
   if (reuse && !(*problem)->BuiltWith(settled->problem)) {
-    (*problem)->FollowScales(settled->problem.noise);
+    (*problem)->FollowScales(settled->problem);
   }
   return SolveBatch(dataset, *settled, final_options, model->get(), landmarks,
                     initial_extent, problem, result, error, reuse);

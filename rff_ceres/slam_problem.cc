@@ -11,6 +11,7 @@
 #include "costs/landmark_prior_cost.h"
 #include "costs/odometry_cost.h"
 #include "costs/pose_prior_cost.h"
+#include "glog/logging.h"
 #include "rff_ceres/io/text_parser.h"
 #include "rff_ceres/measurement_types.h"
 #include "rff_ceres/option_error.h"
@@ -92,14 +93,14 @@ ceres::LinearSolverType AutoLinearSolverType(const TrajectoryModel& model) {
 
 namespace {
 
-// Whether problems built under `p` and `o` differ at most in noise scales.
-bool SameButNoise(const ProblemOptions& p, const ProblemOptions& o) {
-  auto same_loss = [](const LossOptions& a, const LossOptions& b) {
-    return BuiltLossName(a.name) == BuiltLossName(b.name) && a.scale == b.scale;
-  };
-  return same_loss(p.loss, o.loss) &&
-         same_loss(p.odometry_loss, o.odometry_loss) &&
-         p.range_calibration.estimate == o.range_calibration.estimate &&
+bool SameLoss(const LossOptions& a, const LossOptions& b) {
+  return BuiltLossName(a.name) == BuiltLossName(b.name) && a.scale == b.scale;
+}
+
+// Whether problems built under `p` and `o` have the same residual blocks:
+// they differ at most in noise scales and losses (which only weight them).
+bool SameResidualBlocks(const ProblemOptions& p, const ProblemOptions& o) {
+  return p.range_calibration.estimate == o.range_calibration.estimate &&
          p.range_calibration.scale_sigma == o.range_calibration.scale_sigma &&
          p.range_calibration.offset_sigma == o.range_calibration.offset_sigma &&
          p.odometry_calibration.estimate == o.odometry_calibration.estimate &&
@@ -114,8 +115,10 @@ bool SameButNoise(const ProblemOptions& p, const ProblemOptions& o) {
 
 bool SlamProblem::BuiltWith(const ProblemOptions& o) const {
   const NoiseScales& n = options_.noise;
-  return SameButNoise(options_, o) && n.range == o.noise.range &&
-         n.bearing == o.noise.bearing && n.odometry == o.noise.odometry;
+  return SameResidualBlocks(options_, o) && SameLoss(options_.loss, o.loss) &&
+         SameLoss(options_.odometry_loss, o.odometry_loss) &&
+         n.range == o.noise.range && n.bearing == o.noise.bearing &&
+         n.odometry == o.noise.odometry;
 }
 
 bool SlamProblem::CanFollowScales(const ProblemOptions& options) const {
@@ -126,10 +129,35 @@ bool SlamProblem::CanFollowScales(const ProblemOptions& options) const {
   // built again.
   const bool calibrated = options_.range_calibration.estimate ||
                           options_.odometry_calibration.estimate;
-  return built_ && weighted_ && !calibrated && SameButNoise(options_, options);
+  std::unique_ptr<ceres::LossFunction> loss, odometry_loss;
+  std::string error;
+  return built_ && weighted_ && !calibrated &&
+         SameResidualBlocks(options_, options) &&
+         CreateLoss(options.loss, "loss", &loss, &error) &&
+         CreateLoss(options.odometry_loss, "odometry_loss", &odometry_loss,
+                    &error);
 }
 
-void SlamProblem::FollowScales(const NoiseScales& noise) {
+bool SlamProblem::SetLosses(const ProblemOptions& options, std::string* error) {
+  std::unique_ptr<ceres::LossFunction> loss, odometry_loss;
+  if (!CreateLoss(options.loss, "loss", &loss, error) ||
+      !CreateLoss(options.odometry_loss, "odometry_loss", &odometry_loss,
+                  error)) {
+    return false;
+  }
+  // "none" leaves the wrappers empty: rho(s) = s, whose correction of the
+  // residuals and Jacobians multiplies by 1, bit for bit no loss at all.
+  loss_.Reset(loss.release(), ceres::TAKE_OWNERSHIP);
+  odometry_loss_.Reset(odometry_loss.release(), ceres::TAKE_OWNERSHIP);
+  options_.loss = options.loss;
+  options_.odometry_loss = options.odometry_loss;
+  return true;
+}
+
+void SlamProblem::FollowScales(const ProblemOptions& options) {
+  const NoiseScales& noise = options.noise;
+  std::string error;
+  CHECK(SetLosses(options, &error)) << error;  // CanFollowScales built them.
   // The products AddObservation and AddOdometry form.
   for (const ObservationWeights& w : observation_weights_) {
     w.cost->SetSigmas(noise.range * w.sigma_range,
@@ -175,7 +203,7 @@ void SlamProblem::AddObservation(const Observation& o) {
   } else {
     weighted_ = false;
   }
-  Remember(problem_->AddResidualBlock(cost, loss_.get(), blocks),
+  Remember(problem_->AddResidualBlock(cost, &loss_, blocks),
            {type.kind, o.t, o.t, o.id, true});
 }
 
@@ -193,11 +221,7 @@ bool CheckCalibrationOptions(const ProblemOptions& options,
 
 bool SlamProblem::Begin(const std::vector<LandmarkId>& landmark_ids,
                         std::string* error) {
-  if (!CreateLoss(options_.loss, "loss", &loss_, error) ||
-      !CreateLoss(options_.odometry_loss, "odometry_loss", &odometry_loss_,
-                  error)) {
-    return false;
-  }
+  if (!SetLosses(options_, error)) return false;
   for (const LandmarkId id : landmark_ids) slots_.emplace(id, 0);
   int slot = 0;
   for (auto& [id, index] : slots_) index = slot++;
@@ -297,7 +321,7 @@ void SlamProblem::AddOdometry(const PreintegratedOdometry& o) {
   } else {
     weighted_ = false;
   }
-  Remember(problem_->AddResidualBlock(cost, odometry_loss_.get(), blocks),
+  Remember(problem_->AddResidualBlock(cost, &odometry_loss_, blocks),
            {"odometry", o.t0, o.t1});
 }
 

@@ -176,14 +176,14 @@ class SlamProblem {
   bool BuiltWith(const ProblemOptions& options) const;
   // Whether FollowScales can make this problem the one Build would give
   // under `options` (which may differ from the problem's in noise scales
-  // only): built whole (Build) with costs that take new weights in place,
-  // and no calibration estimated.
+  // and losses only): built whole (Build) with costs that take new weights
+  // in place, and no calibration estimated.
   bool CanFollowScales(const ProblemOptions& options) const;
-  // Gives the data costs the noise scales `noise` and the trajectory
-  // prior's costs the model's current scales (TrajectoryModel::
+  // Gives the data costs the noise scales and losses of `options` and the
+  // trajectory prior's costs the model's current scales (TrajectoryModel::
   // UpdatePriorCosts), in place, bit for bit as a build would, and drops
   // the kept linearisation.
-  void FollowScales(const NoiseScales& noise);
+  void FollowScales(const ProblemOptions& options);
   // (scale, offset) of the range sensor: (1, 0) unless estimated. Set it
   // before Begin() to start from another value.
   const Eigen::Vector2d& range_calibration() const {
@@ -297,6 +297,9 @@ class SlamProblem {
                       const Eigen::Vector2d& sigma,
                       const Eigen::Vector2d& lower,
                       const Eigen::Vector2d& upper, double* values);
+  // The losses of `options` into loss_ and odometry_loss_ (and options_);
+  // fails for a name or scale CreateLoss refuses.
+  bool SetLosses(const ProblemOptions& options, std::string* error);
   void Remember(ceres::ResidualBlockId id, Source source) {
     source.first_row = DataRowGroup(source.kind, 0);
     source.later_rows = DataRowGroup(source.kind, 1);
@@ -327,8 +330,10 @@ class SlamProblem {
   std::unordered_map<ceres::ResidualBlockId, Source> sources_;
   // Ceres's own lookup scans every residual (without fast removal).
   std::map<LandmarkId, std::vector<ceres::ResidualBlockId>> landmark_residuals_;
-  std::unique_ptr<ceres::LossFunction> loss_;
-  std::unique_ptr<ceres::LossFunction> odometry_loss_;
+  // Every observation's and every odometry residual's loss, the losses
+  // options_ names inside: a settled "auto" changes them in place.
+  ceres::LossFunctionWrapper loss_{nullptr, ceres::TAKE_OWNERSHIP};
+  ceres::LossFunctionWrapper odometry_loss_{nullptr, ceres::TAKE_OWNERSHIP};
   std::unique_ptr<ceres::Problem> problem_;
   // Landmark blocks in one buffer in id order (Ceres orders an elimination
   // group by address: this keeps the solve's arithmetic reproducible).

@@ -339,11 +339,14 @@ bool RunSlamAtOrigin(const Dataset& dataset, const SlamOptions& options,
                        &model, &landmarks, &problem, result, error)) {
         return false;
       }
-    } else if (judged &&
-               !SolveBatch(dataset, settled, ceres_options, model.get(),
-                           &landmarks, initial_extent, &problem, result,
-                           error)) {
-      return false;
+    } else if (judged) {
+      // The judged losses weight the same residuals: the problem follows.
+      const bool reuse = problem->CanFollowScales(settled.problem);
+      if (reuse) problem->FollowScales(settled.problem);
+      if (!SolveBatch(dataset, settled, ceres_options, model.get(), &landmarks,
+                      initial_extent, &problem, result, error, reuse)) {
+        return false;
+      }
     }
   }
   if (!ReportSolution(options, wnoa_mean_solve, *model, landmarks, &settled,

@@ -275,9 +275,9 @@ TEST(SlamProblemTest, BuiltWithTellsEveryResidualOptionApart) {
   }
 }
 
-// A learning round's rescale in place: new noise scales and a new Q_c
-// given to a built WNOA problem make it the problem a build with them
-// gives, every residual and Jacobian entry bit for bit.
+// A learning round's rescale in place: new noise scales, a new Q_c and a
+// settled loss given to a built WNOA problem make it the problem a build
+// with them gives, every residual and Jacobian entry bit for bit.
 TEST(SlamProblemTest, FollowingScalesGivesTheProblemABuildGives) {
   const Dataset dataset = PaperDataset(5, 40, 8, 3);
   ASSERT_FALSE(dataset.odometry.empty());
@@ -287,6 +287,10 @@ TEST(SlamProblemTest, FollowingScalesGivesTheProblemABuildGives) {
   rescaled_options.wnoa.position_qc *= 0.03;
   rescaled_options.wnoa.heading_qc *= 7.0;
   rescaled_options.problem.noise = {0.6, 1.7, 0.4};
+  // "auto" judged: none for the observations, Cauchy for the odometry.
+  ASSERT_EQ(options.problem.loss.name, "auto");
+  rescaled_options.problem.loss.name = "none";
+  rescaled_options.problem.odometry_loss.name = "cauchy";
   std::string error;
   const std::shared_ptr<const MeanFunction> mean =
       BuildPriorMean("constant", dataset, &error);
@@ -317,7 +321,7 @@ TEST(SlamProblemTest, FollowingScalesGivesTheProblemABuildGives) {
   ASSERT_NE(rescaled, nullptr) << error;
   ASSERT_TRUE(problem.CanFollowScales(rescaled_options.problem));
   ASSERT_TRUE(model->AdoptScales(rescaled.get()));
-  problem.FollowScales(rescaled_options.problem.noise);
+  problem.FollowScales(rescaled_options.problem);
   EXPECT_TRUE(problem.BuiltWith(rescaled_options.problem));
 
   auto built_model =
@@ -366,10 +370,14 @@ TEST(SlamProblemTest, FollowingScalesGivesTheProblemABuildGives) {
   problem.problem()->SetParameterBlockConstant(blocks.front());
   EXPECT_NE(problem.BandedLayout(problem.BandColumns()), layout);
 
-  // Another loss is another problem: it is built again.
-  ProblemOptions other_loss = rescaled_options.problem;
-  other_loss.loss.name = "none";
-  EXPECT_FALSE(problem.CanFollowScales(other_loss));
+  // A loss it cannot build is left to a build, which says why.
+  ProblemOptions unknown_loss = rescaled_options.problem;
+  unknown_loss.loss.name = "tukey";
+  EXPECT_FALSE(problem.CanFollowScales(unknown_loss));
+  // Other residual blocks are another problem: it is built again.
+  ProblemOptions other_blocks = rescaled_options.problem;
+  other_blocks.use_odometry = false;
+  EXPECT_FALSE(problem.CanFollowScales(other_blocks));
   // So is one with a calibration estimated (bounded blocks).
   ProblemOptions calibrated = options.problem;
   calibrated.range_calibration.estimate = true;
