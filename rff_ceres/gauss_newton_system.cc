@@ -199,6 +199,23 @@ namespace {
 // Conjugate-gradient steps of GaussNewtonDecrease where H has no envelope.
 constexpr int kMaxDecreaseIterations = 100;
 
+// Whether H's Schur form (t leading columns of `j`, then landmarks) costs
+// no more multiply-adds than the conjugate gradients' bound: the leading
+// Gram row by row, S's landmark part and its factorisation, against two
+// products with J per step.
+bool SchurNoDearerThanIterations(const RowMajorSparse& j, int t) {
+  if (!SchurFormFits(t, j.cols() - t)) return false;
+  double schur = double(t) * t * (j.cols() - t) + double(t) * t * t / 3.0;
+  for (Eigen::Index r = 0; r < j.rows(); ++r) {
+    double leading = 0.0;
+    for (RowMajorSparse::InnerIterator it(j, r); it; ++it) {
+      if (it.col() < t) ++leading;
+    }
+    schur += leading * leading;
+  }
+  return schur <= 2.0 * kMaxDecreaseIterations * j.nonZeros();
+}
+
 }  // namespace
 
 double GaussNewtonDecrease(SlamProblem* problem, bool* exact) {
@@ -213,14 +230,25 @@ double GaussNewtonDecrease(SlamProblem* problem, bool* exact) {
   }
   std::vector<ceres::ResidualBlockId> ids;
   problem->problem()->GetResidualBlocks(&ids);
+  int t = 0;
+  const std::vector<double*> columns = LandmarksLast(problem, &t);
   double cost = 0.0;
   Eigen::VectorXd residuals;
   RowMajorSparse jacobian;
   std::string why;
-  if (!Linearize(problem->problem(), ids, &cost, &residuals, &jacobian, &why)) {
+  if (!Linearize(problem->problem(), ids, &cost, &residuals, &jacobian, &why,
+                 columns)) {
     return kNaN;
   }
   const Eigen::VectorXd gradient = jacobian.transpose() * residuals;
+  if (SchurNoDearerThanIterations(jacobian, t)) {
+    const GaussNewtonSystem system(jacobian, t, Factorization::kSchurOnly);
+    if (system.positive_definite()) {
+      const double decrease = 0.5 * gradient.dot(system.Solve(gradient).col(0));
+      if (exact != nullptr) *exact = std::isfinite(decrease);
+      return decrease;
+    }
+  }
   // Jacobi preconditioner; an empty column (a block no residual moves) has
   // no gradient and keeps x at 0 whatever its entry.
   Eigen::VectorXd diagonal = Eigen::VectorXd::Zero(jacobian.cols());

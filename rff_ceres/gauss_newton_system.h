@@ -146,14 +146,15 @@ bool FactorizeBanded(SlamProblem* problem, BandedSystem* system);
 // whitened, loss-corrected residuals: what the Gauss-Newton model still
 // expects to gain (a minimum leaves nothing). Banded states, and any model
 // a BANDED_CHOLESKY solve left its H for, solve with H's envelope factor
-// (FactorizeBanded); other models take at most 100 steps
-// of conjugate gradients on J^T J with H's diagonal as preconditioner,
-// whose estimate rises towards the value from below (Gauss quadrature:
-// Golub and Meurant 2010, 3.2), so no dense reduced system is factorised
-// for a check and a decrease it finds is there. NaN where it cannot tell
-// (an evaluation fails, H not positive definite). `exact`, when given, is
-// set to whether the value is the decrease itself (the envelope's) rather
-// than a bound or NaN.
+// (FactorizeBanded); other models with H's Schur form where it costs no
+// more than the bound below (few weights beside the landmarks); the rest
+// take at most 100 steps of conjugate gradients on J^T J with H's diagonal
+// as preconditioner, whose estimate rises towards the value from below
+// (Gauss quadrature: Golub and Meurant 2010, 3.2), so no large dense
+// reduced system is factorised for a check and a decrease it finds is
+// there. NaN where it cannot tell (an evaluation fails, H not positive
+// definite). `exact`, when given, is set to whether the value is the
+// decrease itself (a factorisation's) rather than a bound or NaN.
 double GaussNewtonDecrease(SlamProblem* problem, bool* exact = nullptr);
 
 }  // namespace rff
