@@ -113,6 +113,10 @@ QualityReport AssessQuality(
         Short(facts.odometry_calibration[0]) + ", turn scale " +
         Short(facts.odometry_calibration[1]) + ") is held by its bound");
   }
+  for (const std::string& winding : facts.heading_windings) {
+    report.reasons.push_back("the heading winds against the odometry from " +
+                             winding);
+  }
   if (!report.reasons.empty()) report.verdict = "suspect";
   return report;
 }

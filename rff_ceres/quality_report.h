@@ -75,6 +75,9 @@ struct SolveFacts {
   // not estimated, and whether a bound holds it.
   Eigen::Vector2d odometry_calibration = Eigen::Vector2d(1.0, 1.0);
   bool odometry_calibration_at_bound = false;
+  // Stretches where the heading winds whole turns against the odometry
+  // (heading_winding.h): a local minimum.
+  std::vector<std::string> heading_windings;
 };
 
 // `residuals`: whitened residuals by kind (SlamProblem::

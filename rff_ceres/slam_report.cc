@@ -60,6 +60,16 @@ void PrintSlamSummary(const SlamOptions& options, const SlamResult& result,
     }
     *out << "\n";
   }
+  if (!result.heading_windings_unwound.empty()) {
+    *out << "  heading      the first solve wound whole turns against the "
+            "odometry (";
+    const char* separator = "";
+    for (const std::string& winding : result.heading_windings_unwound) {
+      *out << separator << winding;
+      separator = "; ";
+    }
+    *out << "): solved again from it unwound\n";
+  }
   if (!result.noise_learned.empty()) {
     *out << "  noise        sigmas learned as the stated ones times:";
     const char* separator = " ";
@@ -179,6 +189,10 @@ void WriteSummaryJson(const SlamOptions& options, const SlamResult& result,
       << ",\n"
       << "  \"scales_at_boundary\": "
       << JsonStringArray(result.scales_at_boundary) << ",\n"
+      << "  \"heading_windings_unwound\": "
+      << JsonStringArray(result.heading_windings_unwound) << ",\n"
+      << "  \"heading_windings\": " << JsonStringArray(result.heading_windings)
+      << ",\n"
       << "  \"noise_scales_kept\": " << JsonStringArray(result.noise_kept)
       << ",\n"
       << "  \"noise_scales_learned\": " << JsonStringArray(result.noise_learned)

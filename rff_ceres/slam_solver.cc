@@ -12,6 +12,7 @@
 #include "rff_ceres/batch_solver.h"
 #include "rff_ceres/dead_reckoning.h"
 #include "rff_ceres/gauss_newton_system.h"
+#include "rff_ceres/heading_winding.h"
 #include "rff_ceres/incremental_solver.h"
 #include "rff_ceres/initialization.h"
 #include "rff_ceres/landmark_init.h"
@@ -43,6 +44,7 @@ namespace {
 // What the quality report needs from the solve besides the residuals.
 SolveFacts SolveFactsOf(const SlamOptions& options, const SlamResult& result) {
   SolveFacts facts;
+  facts.heading_windings = result.heading_windings;
   facts.converged = result.converged;
   facts.termination =
       ceres::TerminationTypeToString(result.summary.termination_type);
@@ -171,6 +173,11 @@ bool ReportSolution(const SlamOptions& options,
   result->wnoa_options = wnoa_mean_solve.trajectory.empty()
                              ? settled->wnoa
                              : wnoa_mean_solve.wnoa_options;
+  // And what that solve unwound on its way.
+  result->heading_windings_unwound.insert(
+      result->heading_windings_unwound.begin(),
+      wnoa_mean_solve.heading_windings_unwound.begin(),
+      wnoa_mean_solve.heading_windings_unwound.end());
   PriorOf(options).RecordModel(model, result);
   if (!problem->CheckLandmarksDetermined(1e12, error)) return false;
   if (options.output.quality) {
@@ -331,6 +338,13 @@ bool RunSlamAtOrigin(const Dataset& dataset, const SlamOptions& options,
                          result, error)) {
     return false;
   } else {
+    // A heading that wound whole turns against the odometry is a local
+    // minimum the robust loss holds: started again from it unwound.
+    if (!UnwindAndSolveAgain(
+            dataset, settled, JudgingOptions(settled.problem, ceres_options),
+            model.get(), &landmarks, initial_extent, &problem, result, error)) {
+      return false;
+    }
     // Finishes the judging solve: a learning round's solves come first.
     const bool judged = SettleAutoLosses(problem.get(), &settled.problem);
     if (wnoa_learns || correction) {
@@ -347,6 +361,11 @@ bool RunSlamAtOrigin(const Dataset& dataset, const SlamOptions& options,
                       initial_extent, &problem, result, error, reuse)) {
         return false;
       }
+    }
+  }
+  if (settled.problem.use_odometry) {
+    for (const HeadingWinding& w : FindHeadingWindings(dataset, *model)) {
+      result->heading_windings.push_back(DescribeWinding(w));
     }
   }
   if (!ReportSolution(options, wnoa_mean_solve, *model, landmarks, &settled,

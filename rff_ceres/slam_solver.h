@@ -84,6 +84,11 @@ struct SlamResult {
   Eigen::Vector2d range_calibration = Eigen::Vector2d(1.0, 0.0);
   // (translation scale, turn scale) of the odometry; (1, 1) unless estimated.
   Eigen::Vector2d odometry_calibration = Eigen::Vector2d(1.0, 1.0);
+  // Stretches where the first solve's heading wound whole turns against the
+  // odometry and a solve from the unwound poses ended lower
+  // (heading_winding.h), and those the solution still has.
+  std::vector<std::string> heading_windings_unwound;
+  std::vector<std::string> heading_windings;
   // The whitened residuals at the solution and the verdict on them.
   QualityReport quality;
   // The observation and odometry losses as solved: an "auto" loss settles on

@@ -1,0 +1,159 @@
+#include "rff_ceres/heading_winding.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+#include "rff_ceres/batch_solver.h"
+#include "rff_ceres/initialization.h"
+#include "rff_ceres/io/text_parser.h"
+
+namespace rff {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+// The ODOM records in time order.
+std::vector<const Odometry*> RecordsInTime(const Dataset& dataset) {
+  std::vector<const Odometry*> records;
+  for (const Odometry& o : dataset.odometry) records.push_back(&o);
+  std::stable_sort(
+      records.begin(), records.end(),
+      [](const Odometry* a, const Odometry* b) { return a->t0 < b->t0; });
+  return records;
+}
+
+}  // namespace
+
+std::vector<HeadingWinding> FindHeadingWindings(const Dataset& dataset,
+                                                const TrajectoryModel& model) {
+  std::vector<HeadingWinding> windings;
+  HeadingWinding run;
+  double run_sign = 0.0;
+  auto close = [&] {
+    const double total =
+        std::accumulate(run.excess.begin(), run.excess.end(), 0.0);
+    if (std::abs(total) > kPi) {
+      run.turns = static_cast<int>(std::lround(total / (2.0 * kPi)));
+      if (run.turns == 0) run.turns = total > 0.0 ? 1 : -1;
+      windings.push_back(run);
+    }
+    run = HeadingWinding();
+    run_sign = 0.0;
+  };
+  for (const Odometry* o : RecordsInTime(dataset)) {
+    const double d = model.Pose(o->t1).z() - model.Pose(o->t0).z() - o->dtheta;
+    const bool outlier = std::isfinite(d) && std::abs(o->dtheta) <= kPi / 2 &&
+                         std::abs(d) > kWindingSigmas * o->sigma_theta;
+    const double sign = d > 0.0 ? 1.0 : -1.0;
+    // Consecutive: the record starts where the run's last one ended.
+    const bool continues =
+        !run.excess.empty() && sign == run_sign &&
+        std::abs(o->t0 - run.t1) <= 1e-12 * std::max(1.0, std::abs(o->t0));
+    if (!outlier || !continues) close();
+    if (!outlier) continue;
+    if (run.excess.empty()) {
+      run.t0 = o->t0;
+      run_sign = sign;
+    }
+    run.t1 = o->t1;
+    run.excess.push_back(d);
+  }
+  close();
+  return windings;
+}
+
+std::string DescribeWinding(const HeadingWinding& winding) {
+  return "t = " + FormatNumber(winding.t0) + " to " + FormatNumber(winding.t1) +
+         ": " + (winding.turns > 0 ? "+" : "") + std::to_string(winding.turns) +
+         (std::abs(winding.turns) == 1 ? " turn" : " turns");
+}
+
+std::vector<TimedPose> UnwindHeadings(
+    const std::vector<HeadingWinding>& windings, const Dataset& dataset,
+    std::vector<TimedPose> poses) {
+  const std::vector<const Odometry*> records = RecordsInTime(dataset);
+  for (const HeadingWinding& w : windings) {
+    const double whole = 2.0 * kPi * w.turns;
+    const double total = std::accumulate(w.excess.begin(), w.excess.end(), 0.0);
+    // The run's records, in order: those from t0 whose excess it holds.
+    auto first =
+        std::lower_bound(records.begin(), records.end(), w.t0,
+                         [](const Odometry* o, double t) { return o->t0 < t; });
+    for (TimedPose& p : poses) {
+      if (p.t >= w.t1) {
+        p.theta -= whole;
+        continue;
+      }
+      if (p.t <= w.t0) continue;
+      double taken = 0.0;  // Excess of the run up to p.t.
+      auto it = first;
+      for (const double d : w.excess) {
+        const Odometry& o = **it++;
+        if (p.t >= o.t1) {
+          taken += d;
+        } else {
+          if (p.t > o.t0) taken += d * (p.t - o.t0) / (o.t1 - o.t0);
+          break;
+        }
+      }
+      p.theta -= whole * taken / total;
+    }
+  }
+  return poses;
+}
+
+bool UnwindAndSolveAgain(const Dataset& dataset, const SlamOptions& options,
+                         const ceres::Solver::Options& ceres_options,
+                         TrajectoryModel* model,
+                         std::map<LandmarkId, Eigen::Vector2d>* landmarks,
+                         double initial_extent,
+                         std::unique_ptr<SlamProblem>* problem,
+                         SlamResult* result, std::string* error) {
+  if (!options.problem.use_odometry) return true;  // Nothing to wind against.
+  const std::vector<HeadingWinding> windings =
+      FindHeadingWindings(dataset, *model);
+  if (windings.empty()) return true;
+  // The model's poses at every time a state or residual may sit at.
+  std::vector<double> times = OutputTimes(dataset);
+  for (const Odometry& o : dataset.odometry) {
+    times.push_back(o.t0);
+    times.push_back(o.t1);
+  }
+  for (const Observation& o : dataset.observations) times.push_back(o.t);
+  std::sort(times.begin(), times.end());
+  times.erase(std::unique(times.begin(), times.end()), times.end());
+  std::vector<TimedPose> poses;
+  for (const double t : times) {
+    const Eigen::Vector3d p = model->Pose(t);
+    poses.push_back({t, p.x(), p.y(), p.z()});
+  }
+  const std::vector<double> blocks = ModelBlocks(*model);
+  const std::map<LandmarkId, Eigen::Vector2d> solved_landmarks = *landmarks;
+  const SlamResult solved = *result;
+  if (!FitModelToPoses(UnwindHeadings(windings, dataset, poses), model,
+                       error) ||
+      !SolveBatch(dataset, options, ceres_options, model, landmarks,
+                  initial_extent, problem, result, error,
+                  /*reuse_problem=*/true)) {
+    return false;
+  }
+  if (result->summary.final_cost < solved.summary.final_cost) {
+    for (const HeadingWinding& w : windings) {
+      result->heading_windings_unwound.push_back(DescribeWinding(w));
+    }
+    return true;
+  }
+  // The spin was the better fit: back to it (its iterations counted).
+  const int iterations = result->total_iterations;
+  SetModelBlocks(blocks, model);
+  for (const auto& [id, position] : solved_landmarks) {
+    Eigen::Map<Eigen::Vector2d>((*problem)->landmark_block(id)) = position;
+  }
+  *landmarks = solved_landmarks;
+  *result = solved;
+  result->total_iterations = iterations;
+  return true;
+}
+
+}  // namespace rff

@@ -1,0 +1,71 @@
+// Whole extra turns of the estimated heading against the odometry. Every
+// residual sees the heading wrapped, so a stretch where the estimate spins
+// a full turn more than the odometry says costs only the odometry's rows
+// there, each far beyond its sigma, which a robust loss caps: a local
+// minimum no residual's size calls out (MRCLAM robot 3 from dead reckoning
+// 120 degrees off: three stretches of 3 s, headings up to 177 degrees off
+// while the positions stay within 0.1 m). Over ODOM record k, with the
+// estimate's heading theta(t) unwrapped,
+//
+//   d_k = theta(t1_k) - theta(t0_k) - dtheta_k,
+//
+// and a winding is a run of consecutive records whose d_k all exceed
+// kWindingSigmas of their stated sigma with one sign and add up to more
+// than half a turn.
+#ifndef RFF_CERES_HEADING_WINDING_H_
+#define RFF_CERES_HEADING_WINDING_H_
+
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "ceres/solver.h"
+#include "rff_ceres/slam_problem.h"
+#include "rff_ceres/slam_solver.h"
+#include "rff_ceres/trajectory_model.h"
+#include "rff_ceres/types.h"
+
+namespace rff {
+
+inline constexpr double kWindingSigmas = 3.0;
+
+struct HeadingWinding {
+  double t0 = 0.0,
+         t1 = 0.0;  // From the first record's start to the last's end.
+  int turns = 0;    // Extra turns of the estimate, signed.
+  std::vector<double> excess;  // d_k of the run's records, in order.
+};
+
+// The windings of `model`'s heading against `dataset`'s ODOM records, in
+// time order. Records that turn by more than a quarter turn (their dtheta
+// may have been wrapped) end a run.
+std::vector<HeadingWinding> FindHeadingWindings(const Dataset& dataset,
+                                                const TrajectoryModel& model);
+
+// "t = T0 to T1: +N turn(s)", for reports.
+std::string DescribeWinding(const HeadingWinding& winding);
+
+// `poses` (sorted by time) with the windings taken out: inside a run the
+// heading loses the excess of the records so far (linear within a record),
+// after it the run's whole turns, which no residual sees.
+std::vector<TimedPose> UnwindHeadings(
+    const std::vector<HeadingWinding>& windings, const Dataset& dataset,
+    std::vector<TimedPose> poses);
+
+// After a solve of `model` (the judging solve of RunSlam) that used the
+// odometry: where its heading winds against it, starts again from the
+// unwound poses and keeps that solve where it ends at a lower cost (else
+// the values and result as they were). result->heading_windings_unwound
+// records what was taken out.
+bool UnwindAndSolveAgain(const Dataset& dataset, const SlamOptions& options,
+                         const ceres::Solver::Options& ceres_options,
+                         TrajectoryModel* model,
+                         std::map<LandmarkId, Eigen::Vector2d>* landmarks,
+                         double initial_extent,
+                         std::unique_ptr<SlamProblem>* problem,
+                         SlamResult* result, std::string* error);
+
+}  // namespace rff
+
+#endif  // RFF_CERES_HEADING_WINDING_H_
