@@ -103,17 +103,17 @@ std::vector<TimedPose> UnwindHeadings(
   return poses;
 }
 
-bool UnwindAndSolveAgain(const Dataset& dataset, const SlamOptions& options,
+void UnwindAndSolveAgain(const Dataset& dataset, const SlamOptions& options,
                          const ceres::Solver::Options& ceres_options,
                          TrajectoryModel* model,
                          std::map<LandmarkId, Eigen::Vector2d>* landmarks,
                          double initial_extent,
                          std::unique_ptr<SlamProblem>* problem,
-                         SlamResult* result, std::string* error) {
-  if (!options.problem.use_odometry) return true;  // Nothing to wind against.
+                         SlamResult* result) {
+  if (!options.problem.use_odometry) return;  // Nothing to wind against.
   const std::vector<HeadingWinding> windings =
       FindHeadingWindings(dataset, *model);
-  if (windings.empty()) return true;
+  if (windings.empty()) return;
   // The model's poses at every time a state or residual may sit at.
   std::vector<double> times = OutputTimes(dataset);
   for (const Odometry& o : dataset.odometry) {
@@ -131,20 +131,21 @@ bool UnwindAndSolveAgain(const Dataset& dataset, const SlamOptions& options,
   const std::vector<double> blocks = ModelBlocks(*model);
   const std::map<LandmarkId, Eigen::Vector2d> solved_landmarks = *landmarks;
   const SlamResult solved = *result;
-  if (!FitModelToPoses(UnwindHeadings(windings, dataset, poses), model,
-                       error) ||
-      !SolveBatch(dataset, options, ceres_options, model, landmarks,
-                  initial_extent, problem, result, error,
-                  /*reuse_problem=*/true)) {
-    return false;
-  }
-  if (result->summary.final_cost < solved.summary.final_cost) {
+  // A start it cannot fit or a solve that fails from it (diverges) leaves
+  // the first solution as it was.
+  std::string why;
+  const bool solved_again =
+      FitModelToPoses(UnwindHeadings(windings, dataset, poses), model, &why) &&
+      SolveBatch(dataset, options, ceres_options, model, landmarks,
+                 initial_extent, problem, result, &why,
+                 /*reuse_problem=*/true);
+  if (solved_again && result->summary.final_cost < solved.summary.final_cost) {
     for (const HeadingWinding& w : windings) {
       result->heading_windings_unwound.push_back(DescribeWinding(w));
     }
-    return true;
+    return;
   }
-  // The spin was the better fit: back to it (its iterations counted).
+  // The spin was the better fit: back to it (the iterations counted).
   const int iterations = result->total_iterations;
   SetModelBlocks(blocks, model);
   for (const auto& [id, position] : solved_landmarks) {
@@ -153,7 +154,6 @@ bool UnwindAndSolveAgain(const Dataset& dataset, const SlamOptions& options,
   *landmarks = solved_landmarks;
   *result = solved;
   result->total_iterations = iterations;
-  return true;
 }
 
 }  // namespace rff

@@ -56,15 +56,16 @@ std::vector<TimedPose> UnwindHeadings(
 // After a solve of `model` (the judging solve of RunSlam) that used the
 // odometry: where its heading winds against it, starts again from the
 // unwound poses and keeps that solve where it ends at a lower cost (else
-// the values and result as they were). result->heading_windings_unwound
-// records what was taken out.
-bool UnwindAndSolveAgain(const Dataset& dataset, const SlamOptions& options,
+// the values and result as they were: a start it cannot fit or a solve
+// that fails from it changes nothing either). result->
+// heading_windings_unwound records what was taken out.
+void UnwindAndSolveAgain(const Dataset& dataset, const SlamOptions& options,
                          const ceres::Solver::Options& ceres_options,
                          TrajectoryModel* model,
                          std::map<LandmarkId, Eigen::Vector2d>* landmarks,
                          double initial_extent,
                          std::unique_ptr<SlamProblem>* problem,
-                         SlamResult* result, std::string* error);
+                         SlamResult* result);
 
 }  // namespace rff
 

@@ -340,11 +340,9 @@ bool RunSlamAtOrigin(const Dataset& dataset, const SlamOptions& options,
   } else {
     // A heading that wound whole turns against the odometry is a local
     // minimum the robust loss holds: started again from it unwound.
-    if (!UnwindAndSolveAgain(
-            dataset, settled, JudgingOptions(settled.problem, ceres_options),
-            model.get(), &landmarks, initial_extent, &problem, result, error)) {
-      return false;
-    }
+    UnwindAndSolveAgain(
+        dataset, settled, JudgingOptions(settled.problem, ceres_options),
+        model.get(), &landmarks, initial_extent, &problem, result);
     // Finishes the judging solve: a learning round's solves come first.
     const bool judged = SettleAutoLosses(problem.get(), &settled.problem);
     if (wnoa_learns || correction) {
