@@ -5,6 +5,7 @@
 #include <numeric>
 
 #include "rff_ceres/batch_solver.h"
+#include "rff_ceres/convert/pose_graph.h"
 #include "rff_ceres/initialization.h"
 #include "rff_ceres/io/text_parser.h"
 
@@ -114,19 +115,15 @@ void UnwindAndSolveAgain(const Dataset& dataset, const SlamOptions& options,
   const std::vector<HeadingWinding> windings =
       FindHeadingWindings(dataset, *model);
   if (windings.empty()) return;
-  // The model's poses at every time a state or residual may sit at.
-  std::vector<double> times = OutputTimes(dataset);
-  for (const Odometry& o : dataset.odometry) {
-    times.push_back(o.t0);
-    times.push_back(o.t1);
-  }
-  for (const Observation& o : dataset.observations) times.push_back(o.t);
+  // The model's poses at every time a state, residual or output sits at.
+  std::vector<double> times = PoseVertexTimes(dataset);
+  for (const double t : OutputTimes(dataset)) times.push_back(t);
   std::sort(times.begin(), times.end());
-  times.erase(std::unique(times.begin(), times.end()), times.end());
   std::vector<TimedPose> poses;
-  for (const double t : times) {
-    const Eigen::Vector3d p = model->Pose(t);
-    poses.push_back({t, p.x(), p.y(), p.z()});
+  for (std::size_t k = 0; k < times.size(); ++k) {
+    if (k > 0 && times[k] == times[k - 1]) continue;
+    const Eigen::Vector3d p = model->Pose(times[k]);
+    poses.push_back({times[k], p.x(), p.y(), p.z()});
   }
   const std::vector<double> blocks = ModelBlocks(*model);
   const std::map<LandmarkId, Eigen::Vector2d> solved_landmarks = *landmarks;

@@ -68,6 +68,33 @@ std::unique_ptr<TrajectoryModel> WnoaModel(const Dataset& dataset,
   return model;
 }
 
+// `dataset` solved by SolveBatch with `options` from `start` (the model fit
+// to it), the landmarks at the truth.
+struct Solved {
+  std::unique_ptr<TrajectoryModel> model;
+  std::map<LandmarkId, Eigen::Vector2d> landmarks;
+  ceres::Solver::Options ceres_options;
+  std::unique_ptr<SlamProblem> problem;
+  SlamResult result;
+};
+
+void SolveFrom(const Dataset& dataset, const SlamOptions& options,
+               const std::vector<TimedPose>& start, Solved* solved) {
+  solved->model = WnoaModel(dataset, options);
+  ASSERT_NE(solved->model, nullptr);
+  std::string error;
+  ASSERT_TRUE(FitModelToPoses(start, solved->model.get(), &error)) << error;
+  for (const Landmark& l : dataset.ground_truth_landmarks) {
+    solved->landmarks[l.id] = Eigen::Vector2d(l.x, l.y);
+  }
+  ASSERT_TRUE(ToCeresOptions(options.solver, &solved->ceres_options, &error))
+      << error;
+  ASSERT_TRUE(SolveBatch(dataset, options, solved->ceres_options,
+                         solved->model.get(), &solved->landmarks, 100.0,
+                         &solved->problem, &solved->result, &error))
+      << error;
+}
+
 // A turn the odometry does not have, over twelve of its records, is found
 // with its stretch and sign; taken out, the heading is the truth's again
 // to the odometry's noise, and nothing is found. The truth itself has none.
@@ -128,29 +155,18 @@ TEST(HeadingWindingTest, SolvedAgainFromTheUnwoundPosesEndsLower) {
   const Dataset dataset = Simulated(1);
   SlamOptions options;
   options.prior = "wnoa";
-  std::unique_ptr<TrajectoryModel> model = WnoaModel(dataset, options);
-  ASSERT_NE(model, nullptr);
-  std::string error;
   const std::vector<TimedPose> truth = Unwrapped(dataset.ground_truth);
-  const double t0 = dataset.odometry[20].t0, t1 = dataset.odometry[31].t1;
-  ASSERT_TRUE(FitModelToPoses(Spun(truth, t0, t1), model.get(), &error))
-      << error;
-  std::map<LandmarkId, Eigen::Vector2d> landmarks;
-  for (const Landmark& l : dataset.ground_truth_landmarks) {
-    landmarks[l.id] = Eigen::Vector2d(l.x, l.y);
-  }
-  ceres::Solver::Options ceres_options;
-  ASSERT_TRUE(ToCeresOptions(options.solver, &ceres_options, &error)) << error;
-  std::unique_ptr<SlamProblem> problem;
-  SlamResult result;
-  ASSERT_TRUE(SolveBatch(dataset, options, ceres_options, model.get(),
-                         &landmarks, 100.0, &problem, &result, &error))
-      << error;
+  Solved s;
+  ASSERT_NO_FATAL_FAILURE(SolveFrom(
+      dataset, options,
+      Spun(truth, dataset.odometry[20].t0, dataset.odometry[31].t1), &s));
+  TrajectoryModel* model = s.model.get();
+  SlamResult& result = s.result;
   ASSERT_EQ(FindHeadingWindings(dataset, *model).size(), 1u);
   const double spun_cost = result.summary.final_cost;
 
-  UnwindAndSolveAgain(dataset, options, ceres_options, model.get(), &landmarks,
-                      100.0, &problem, &result);
+  UnwindAndSolveAgain(dataset, options, s.ceres_options, model, &s.landmarks,
+                      100.0, &s.problem, &result);
   EXPECT_EQ(result.heading_windings_unwound,
             std::vector<std::string>{"t = 24 to 28: +1 turn"});
   std::printf("cost %.6g spun, %.6g unwound\n", spun_cost,
@@ -176,34 +192,23 @@ TEST(HeadingWindingTest, ATurnTheDataHaveIsKept) {
   for (int k = 20; k < 32; ++k) dataset.odometry[k].dtheta -= kTwoPi / 12.0;
   SlamOptions options;
   options.prior = "wnoa";
-  std::unique_ptr<TrajectoryModel> model = WnoaModel(dataset, options);
-  ASSERT_NE(model, nullptr);
-  std::string error;
-  ASSERT_TRUE(
-      FitModelToPoses(Unwrapped(dataset.ground_truth), model.get(), &error))
-      << error;
-  std::map<LandmarkId, Eigen::Vector2d> landmarks;
-  for (const Landmark& l : dataset.ground_truth_landmarks) {
-    landmarks[l.id] = Eigen::Vector2d(l.x, l.y);
-  }
-  ceres::Solver::Options ceres_options;
-  ASSERT_TRUE(ToCeresOptions(options.solver, &ceres_options, &error)) << error;
-  std::unique_ptr<SlamProblem> problem;
-  SlamResult result;
-  ASSERT_TRUE(SolveBatch(dataset, options, ceres_options, model.get(),
-                         &landmarks, 100.0, &problem, &result, &error))
-      << error;
+  Solved s;
+  ASSERT_NO_FATAL_FAILURE(
+      SolveFrom(dataset, options, Unwrapped(dataset.ground_truth), &s));
+  TrajectoryModel* model = s.model.get();
+  std::map<LandmarkId, Eigen::Vector2d>& landmarks = s.landmarks;
+  SlamResult& result = s.result;
   ASSERT_EQ(FindHeadingWindings(dataset, *model).size(), 1u);
   const std::vector<double> solved = ModelBlocks(*model);
   const std::map<LandmarkId, Eigen::Vector2d> solved_landmarks = landmarks;
   const SlamResult first = result;
 
-  UnwindAndSolveAgain(dataset, options, ceres_options, model.get(), &landmarks,
-                      100.0, &problem, &result);
+  UnwindAndSolveAgain(dataset, options, s.ceres_options, model, &landmarks,
+                      100.0, &s.problem, &result);
   EXPECT_TRUE(result.heading_windings_unwound.empty());
   EXPECT_EQ(ModelBlocks(*model), solved);
   EXPECT_EQ(landmarks, solved_landmarks);
-  EXPECT_EQ((*problem).landmarks(), solved_landmarks);
+  EXPECT_EQ(s.problem->landmarks(), solved_landmarks);
   EXPECT_EQ(result.summary.final_cost, first.summary.final_cost);
   EXPECT_GT(result.total_iterations, first.total_iterations);
 }
