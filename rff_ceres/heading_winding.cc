@@ -8,6 +8,7 @@
 #include "rff_ceres/convert/pose_graph.h"
 #include "rff_ceres/initialization.h"
 #include "rff_ceres/io/text_parser.h"
+#include "rff_ceres/mean_rotation.h"
 
 namespace rff {
 namespace {
@@ -111,7 +112,13 @@ void UnwindAndSolveAgain(const Dataset& dataset, const SlamOptions& options,
                          double initial_extent,
                          std::unique_ptr<SlamProblem>* problem,
                          SlamResult* result) {
-  if (!options.problem.use_odometry) return;  // Nothing to wind against.
+  // Nothing to wind against; or a model whose mean a solve turns or
+  // refits (an unknown start heading, spline rounds), which going back
+  // could not undo: the final check still reports a winding.
+  if (!options.problem.use_odometry || options.mean.outer_rounds > 0 ||
+      dynamic_cast<const MeanRotationTrajectory*>(model) != nullptr) {
+    return;
+  }
   const std::vector<HeadingWinding> windings =
       FindHeadingWindings(dataset, *model);
   if (windings.empty()) return;

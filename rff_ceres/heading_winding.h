@@ -31,9 +31,10 @@ namespace rff {
 inline constexpr double kWindingSigmas = 3.0;
 
 struct HeadingWinding {
-  double t0 = 0.0,
-         t1 = 0.0;  // From the first record's start to the last's end.
-  int turns = 0;    // Extra turns of the estimate, signed.
+  // From the first record's start to the last record's end.
+  double t0 = 0.0;
+  double t1 = 0.0;
+  int turns = 0;               // Extra turns of the estimate, signed.
   std::vector<double> excess;  // d_k of the run's records, in order.
 };
 
@@ -54,11 +55,12 @@ std::vector<TimedPose> UnwindHeadings(
     std::vector<TimedPose> poses);
 
 // After a solve of `model` (the judging solve of RunSlam) that used the
-// odometry: where its heading winds against it, starts again from the
-// unwound poses and keeps that solve where it ends at a lower cost (else
-// the values and result as they were: a start it cannot fit or a solve
-// that fails from it changes nothing either). result->
-// heading_windings_unwound records what was taken out.
+// odometry, of a model whose mean the solve neither turns nor refits
+// (MeanRotationTrajectory, spline rounds): where its heading winds against
+// the odometry, starts again from the unwound poses and keeps that solve
+// where it ends at a lower cost (else the values and result as they were:
+// a start it cannot fit or a solve that fails from it changes nothing
+// either). result->heading_windings_unwound records what was taken out.
 void UnwindAndSolveAgain(const Dataset& dataset, const SlamOptions& options,
                          const ceres::Solver::Options& ceres_options,
                          TrajectoryModel* model,
