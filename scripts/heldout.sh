@@ -310,6 +310,8 @@ def run(name, what):
         "reasons": "; ".join(reasons or []),
         "nees": evaluation.get("mean_position_nees"),
         "coverage": evaluation.get("position_coverage_95"),
+        "rot": rms(evaluation, "ape_rot_deg"),
+        "heading_nees": evaluation.get("mean_heading_nees"),
     }
 
 def exact(name):
@@ -447,7 +449,8 @@ with open(os.path.join(out, "heldout.csv"), "w", newline="") as f:
                 "rff_rc", "wnoa_rc", "exact_gp_rc", "rff_verdict",
                 "wnoa_verdict", "rff_quality_reasons", "wnoa_quality_reasons",
                 "rff_position_nees", "rff_coverage_95", "wnoa_position_nees",
-                "wnoa_coverage_95"])
+                "wnoa_coverage_95", "rff_ape_rot_deg", "wnoa_ape_rot_deg",
+                "rff_heading_nees", "wnoa_heading_nees"])
     get = lambda x, k: "" if x is None or x.get(k) is None else x[k]
     for r in rows:
         w.writerow([r["name"], r["split"], r["kind"], get(r["dr"], "ape"),
@@ -459,5 +462,8 @@ with open(os.path.join(out, "heldout.csv"), "w", newline="") as f:
                     get(r["rff"], "verdict"), get(r["wnoa"], "verdict"),
                     get(r["rff"], "reasons"), get(r["wnoa"], "reasons"),
                     get(r["rff"], "nees"), get(r["rff"], "coverage"),
-                    get(r["wnoa"], "nees"), get(r["wnoa"], "coverage")])
+                    get(r["wnoa"], "nees"), get(r["wnoa"], "coverage"),
+                    get(r["rff"], "rot"), get(r["wnoa"], "rot"),
+                    get(r["rff"], "heading_nees"),
+                    get(r["wnoa"], "heading_nees")])
 EOF
