@@ -28,7 +28,8 @@ std::vector<const Odometry*> RecordsInTime(const Dataset& dataset) {
 }  // namespace
 
 std::vector<HeadingWinding> FindHeadingWindings(const Dataset& dataset,
-                                                const TrajectoryModel& model) {
+                                                const TrajectoryModel& model,
+                                                double turn_scale) {
   std::vector<HeadingWinding> windings;
   HeadingWinding run;
   double run_sign = 0.0;
@@ -44,9 +45,16 @@ std::vector<HeadingWinding> FindHeadingWindings(const Dataset& dataset,
     run_sign = 0.0;
   };
   for (const Odometry* o : RecordsInTime(dataset)) {
-    const double d = model.Pose(o->t1).z() - model.Pose(o->t0).z() - o->dtheta;
-    const bool outlier = std::isfinite(d) && std::abs(o->dtheta) <= kPi / 2 &&
-                         std::abs(d) > kWindingSigmas * o->sigma_theta;
+    // The disagreement the odometry residual sees (wrapped: a record that
+    // turns by more than pi is recorded wrapped), in the estimate's units.
+    const double d = std::remainder(turn_scale * (model.Pose(o->t1).z() -
+                                                  model.Pose(o->t0).z()) -
+                                        o->dtheta,
+                                    2.0 * kPi) /
+                     turn_scale;
+    const bool outlier =
+        std::isfinite(d) &&
+        std::abs(turn_scale * d) > kWindingSigmas * o->sigma_theta;
     const double sign = d > 0.0 ? 1.0 : -1.0;
     // Consecutive: the record starts where the run's last one ended.
     const bool continues =
@@ -120,7 +128,7 @@ void UnwindAndSolveAgain(const Dataset& dataset, const SlamOptions& options,
     return;
   }
   const std::vector<HeadingWinding> windings =
-      FindHeadingWindings(dataset, *model);
+      FindHeadingWindings(dataset, *model, result->odometry_calibration[1]);
   if (windings.empty()) return;
   // The model's poses at every time a state, residual or output sits at.
   std::vector<double> times = PoseVertexTimes(dataset);
@@ -155,6 +163,8 @@ void UnwindAndSolveAgain(const Dataset& dataset, const SlamOptions& options,
   for (const auto& [id, position] : solved_landmarks) {
     Eigen::Map<Eigen::Vector2d>((*problem)->landmark_block(id)) = position;
   }
+  (*problem)->set_range_calibration(solved.range_calibration);
+  (*problem)->set_odometry_calibration(solved.odometry_calibration);
   *landmarks = solved_landmarks;
   *result = solved;
   result->total_iterations = iterations;

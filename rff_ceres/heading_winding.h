@@ -4,10 +4,11 @@
 // there, each far beyond its sigma, which a robust loss caps: a local
 // minimum no residual's size calls out (MRCLAM robot 3 from dead reckoning
 // 120 degrees off: three stretches of 3 s, headings up to 177 degrees off
-// while the positions stay within 0.1 m). Over ODOM record k, with the
-// estimate's heading theta(t) unwrapped,
+// while the positions stay within 0.1 m). Unwound after the learning, not
+// before: a winding the rounds would remove is left to them. Over ODOM
+// record k, with the estimate's heading theta(t) unwrapped,
 //
-//   d_k = theta(t1_k) - theta(t0_k) - dtheta_k,
+//   d_k = wrap(theta(t1_k) - theta(t0_k) - dtheta_k),
 //
 // and a winding is a run of consecutive records whose d_k all exceed
 // kWindingSigmas of their stated sigma with one sign and add up to more
@@ -39,10 +40,13 @@ struct HeadingWinding {
 };
 
 // The windings of `model`'s heading against `dataset`'s ODOM records, in
-// time order. Records that turn by more than a quarter turn (their dtheta
-// may have been wrapped) end a run.
+// time order, with the records' turns `turn_scale` times the true ones
+// (an estimated odometry calibration; 1 without). d_k is taken wrapped, as
+// the odometry residual sees it: a record that turns by more than pi is
+// recorded wrapped, and no turn hides in it.
 std::vector<HeadingWinding> FindHeadingWindings(const Dataset& dataset,
-                                                const TrajectoryModel& model);
+                                                const TrajectoryModel& model,
+                                                double turn_scale = 1.0);
 
 // "t = T0 to T1: +N turn(s)", for reports.
 std::string DescribeWinding(const HeadingWinding& winding);
@@ -54,13 +58,14 @@ std::vector<TimedPose> UnwindHeadings(
     const std::vector<HeadingWinding>& windings, const Dataset& dataset,
     std::vector<TimedPose> poses);
 
-// After a solve of `model` (the judging solve of RunSlam) that used the
-// odometry, of a model whose mean the solve neither turns nor refits
-// (MeanRotationTrajectory, spline rounds): where its heading winds against
-// the odometry, starts again from the unwound poses and keeps that solve
-// where it ends at a lower cost (else the values and result as they were:
-// a start it cannot fit or a solve that fails from it changes nothing
-// either). result->heading_windings_unwound records what was taken out.
+// After the solve of `model` (RunSlam's last, the learning's included)
+// that used the odometry, of a model whose mean the solve neither turns
+// nor refits (MeanRotationTrajectory, spline rounds): where its heading
+// winds against the odometry, starts again from the unwound poses and
+// keeps that solve where it ends at a lower cost (else the values, the
+// calibrations and the result as they were: a start it cannot fit or a
+// solve that fails from it changes nothing either). result->
+// heading_windings_unwound records what was taken out.
 void UnwindAndSolveAgain(const Dataset& dataset, const SlamOptions& options,
                          const ceres::Solver::Options& ceres_options,
                          TrajectoryModel* model,

@@ -61,7 +61,7 @@ void PrintSlamSummary(const SlamOptions& options, const SlamResult& result,
     *out << "\n";
   }
   if (!result.heading_windings_unwound.empty()) {
-    *out << "  heading      the first solve wound whole turns against the "
+    *out << "  heading      the solve wound whole turns against the "
             "odometry (";
     const char* separator = "";
     for (const std::string& winding : result.heading_windings_unwound) {

@@ -338,11 +338,6 @@ bool RunSlamAtOrigin(const Dataset& dataset, const SlamOptions& options,
                          result, error)) {
     return false;
   } else {
-    // A heading that wound whole turns against the odometry is a local
-    // minimum the robust loss holds: started again from it unwound.
-    UnwindAndSolveAgain(
-        dataset, settled, JudgingOptions(settled.problem, ceres_options),
-        model.get(), &landmarks, initial_extent, &problem, result);
     // Finishes the judging solve: a learning round's solves come first.
     const bool judged = SettleAutoLosses(problem.get(), &settled.problem);
     if (wnoa_learns || correction) {
@@ -360,9 +355,14 @@ bool RunSlamAtOrigin(const Dataset& dataset, const SlamOptions& options,
         return false;
       }
     }
+    // A heading that wound whole turns against the odometry is a local
+    // minimum the robust loss holds: started again from it unwound.
+    UnwindAndSolveAgain(dataset, settled, ceres_options, model.get(),
+                        &landmarks, initial_extent, &problem, result);
   }
   if (settled.problem.use_odometry) {
-    for (const HeadingWinding& w : FindHeadingWindings(dataset, *model)) {
+    for (const HeadingWinding& w : FindHeadingWindings(
+             dataset, *model, result->odometry_calibration[1])) {
       result->heading_windings.push_back(DescribeWinding(w));
     }
   }

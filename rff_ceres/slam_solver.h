@@ -84,7 +84,7 @@ struct SlamResult {
   Eigen::Vector2d range_calibration = Eigen::Vector2d(1.0, 0.0);
   // (translation scale, turn scale) of the odometry; (1, 1) unless estimated.
   Eigen::Vector2d odometry_calibration = Eigen::Vector2d(1.0, 1.0);
-  // Stretches where the first solve's heading wound whole turns against the
+  // Stretches where the solve's heading wound whole turns against the
   // odometry and a solve from the unwound poses ended lower
   // (heading_winding.h), and those the solution still has.
   std::vector<std::string> heading_windings_unwound;

@@ -112,6 +112,18 @@ TEST(HeadingWindingTest, FindsATurnTheOdometryDoesNotHaveAndUnwindsIt) {
   const std::vector<TimedPose> truth = Unwrapped(dataset.ground_truth);
   ASSERT_TRUE(FitModelToPoses(truth, model.get(), &error)) << error;
   EXPECT_TRUE(FindHeadingWindings(dataset, *model).empty());
+  // A record's turn written a whole turn off (as a turn beyond pi is
+  // recorded, wrapped) hides no turn from the residual, nor from this.
+  Dataset wrapped = dataset;
+  wrapped.odometry[5].dtheta -= kTwoPi;
+  EXPECT_TRUE(FindHeadingWindings(wrapped, *model).empty());
+  // Turns recorded at 0.4 of the true ones: read with that turn scale (an
+  // estimated odometry calibration), nothing; taken as stated, the circling
+  // robot winds against them.
+  Dataset short_turns = dataset;
+  for (Odometry& o : short_turns.odometry) o.dtheta *= 0.4;
+  EXPECT_TRUE(FindHeadingWindings(short_turns, *model, 0.4).empty());
+  EXPECT_EQ(FindHeadingWindings(short_turns, *model).size(), 1u);
 
   const double t0 = dataset.odometry[20].t0, t1 = dataset.odometry[31].t1;
   const std::vector<TimedPose> spun = Spun(truth, t0, t1);
@@ -217,7 +229,7 @@ TEST(HeadingWindingTest, ATurnTheDataHaveIsKept) {
 }
 
 // The `../shared` MRCLAM robot 3 file (map 1 m off), default flags but the
-// WNOA prior: its first solve from dead reckoning left three 3 s stretches
+// WNOA prior: its solve from dead reckoning ended with three 3 s stretches
 // spun one turn against the odometry (headings up to 177 degrees off, APE
 // rotation RMS 9.6 degrees, verdict ok). They are unwound and none is left
 // (measured 3.0 degrees RMS).
