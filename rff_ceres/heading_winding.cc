@@ -2,8 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numeric>
 
+#include "costs/angle.h"
 #include "rff_ceres/batch_solver.h"
 #include "rff_ceres/convert/pose_graph.h"
 #include "rff_ceres/initialization.h"
@@ -11,101 +11,74 @@
 #include "rff_ceres/mean_rotation.h"
 
 namespace rff {
-namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-
-// The ODOM records in time order.
-std::vector<const Odometry*> RecordsInTime(const Dataset& dataset) {
+std::vector<HeadingWinding> FindHeadingWindings(const Dataset& dataset,
+                                                const TrajectoryModel& model,
+                                                double turn_scale) {
   std::vector<const Odometry*> records;
   for (const Odometry& o : dataset.odometry) records.push_back(&o);
   std::stable_sort(
       records.begin(), records.end(),
       [](const Odometry* a, const Odometry* b) { return a->t0 < b->t0; });
-  return records;
-}
-
-}  // namespace
-
-std::vector<HeadingWinding> FindHeadingWindings(const Dataset& dataset,
-                                                const TrajectoryModel& model,
-                                                double turn_scale) {
   std::vector<HeadingWinding> windings;
   HeadingWinding run;
-  double run_sign = 0.0;
+  double total = 0.0;  // Of the run's excess.
   auto close = [&] {
-    const double total =
-        std::accumulate(run.excess.begin(), run.excess.end(), 0.0);
-    if (std::abs(total) > kPi) {
-      run.turns = static_cast<int>(std::lround(total / (2.0 * kPi)));
+    if (std::abs(total) > M_PI) {
+      run.turns = static_cast<int>(std::lround(total / (2.0 * M_PI)));
       if (run.turns == 0) run.turns = total > 0.0 ? 1 : -1;
       windings.push_back(run);
     }
     run = HeadingWinding();
-    run_sign = 0.0;
+    total = 0.0;
   };
-  for (const Odometry* o : RecordsInTime(dataset)) {
+  for (const Odometry* o : records) {
     // The disagreement the odometry residual sees (wrapped: a record that
     // turns by more than pi is recorded wrapped), in the estimate's units.
-    const double d = std::remainder(turn_scale * (model.Pose(o->t1).z() -
-                                                  model.Pose(o->t0).z()) -
-                                        o->dtheta,
-                                    2.0 * kPi) /
-                     turn_scale;
+    const double d =
+        WrapAngle(turn_scale * (model.Pose(o->t1).z() - model.Pose(o->t0).z()) -
+                  o->dtheta) /
+        turn_scale;
     const bool outlier =
         std::isfinite(d) &&
         std::abs(turn_scale * d) > kWindingSigmas * o->sigma_theta;
-    const double sign = d > 0.0 ? 1.0 : -1.0;
-    // Consecutive: the record starts where the run's last one ended.
+    // Consecutive: one sign, the record starting where the run's last ended.
     const bool continues =
-        !run.excess.empty() && sign == run_sign &&
-        std::abs(o->t0 - run.t1) <= 1e-12 * std::max(1.0, std::abs(o->t0));
+        !run.steps.empty() && (d > 0.0) == (total > 0.0) &&
+        std::abs(o->t0 - run.t1()) <= 1e-12 * std::max(1.0, std::abs(o->t0));
     if (!outlier || !continues) close();
     if (!outlier) continue;
-    if (run.excess.empty()) {
-      run.t0 = o->t0;
-      run_sign = sign;
-    }
-    run.t1 = o->t1;
-    run.excess.push_back(d);
+    run.steps.push_back({o->t0, o->t1, d});
+    total += d;
   }
   close();
   return windings;
 }
 
 std::string DescribeWinding(const HeadingWinding& winding) {
-  return "t = " + FormatNumber(winding.t0) + " to " + FormatNumber(winding.t1) +
-         ": " + (winding.turns > 0 ? "+" : "") + std::to_string(winding.turns) +
+  return "t = " + FormatNumber(winding.t0()) + " to " +
+         FormatNumber(winding.t1()) + ": " + (winding.turns > 0 ? "+" : "") +
+         std::to_string(winding.turns) +
          (std::abs(winding.turns) == 1 ? " turn" : " turns");
 }
 
 std::vector<TimedPose> UnwindHeadings(
-    const std::vector<HeadingWinding>& windings, const Dataset& dataset,
-    std::vector<TimedPose> poses) {
-  const std::vector<const Odometry*> records = RecordsInTime(dataset);
+    const std::vector<HeadingWinding>& windings, std::vector<TimedPose> poses) {
   for (const HeadingWinding& w : windings) {
-    const double whole = 2.0 * kPi * w.turns;
-    const double total = std::accumulate(w.excess.begin(), w.excess.end(), 0.0);
-    // The run's records, in order: those from t0 whose excess it holds.
-    auto first =
-        std::lower_bound(records.begin(), records.end(), w.t0,
-                         [](const Odometry* o, double t) { return o->t0 < t; });
+    const double whole = 2.0 * M_PI * w.turns;
+    double total = 0.0;
+    for (const HeadingWinding::Step& step : w.steps) total += step.excess;
     for (TimedPose& p : poses) {
-      if (p.t >= w.t1) {
+      if (p.t >= w.t1()) {
         p.theta -= whole;
         continue;
       }
-      if (p.t <= w.t0) continue;
       double taken = 0.0;  // Excess of the run up to p.t.
-      auto it = first;
-      for (const double d : w.excess) {
-        const Odometry& o = **it++;
-        if (p.t >= o.t1) {
-          taken += d;
-        } else {
-          if (p.t > o.t0) taken += d * (p.t - o.t0) / (o.t1 - o.t0);
-          break;
-        }
+      for (const HeadingWinding::Step& step : w.steps) {
+        if (p.t <= step.t0) break;
+        taken += p.t >= step.t1
+                     ? step.excess
+                     : step.excess * (p.t - step.t0) / (step.t1 - step.t0);
       }
       p.theta -= whole * taken / total;
     }
@@ -147,7 +120,7 @@ void UnwindAndSolveAgain(const Dataset& dataset, const SlamOptions& options,
   // the first solution as it was.
   std::string why;
   const bool solved_again =
-      FitModelToPoses(UnwindHeadings(windings, dataset, poses), model, &why) &&
+      FitModelToPoses(UnwindHeadings(windings, poses), model, &why) &&
       SolveBatch(dataset, options, ceres_options, model, landmarks,
                  initial_extent, problem, result, &why,
                  /*reuse_problem=*/true);

@@ -32,11 +32,14 @@ namespace rff {
 inline constexpr double kWindingSigmas = 3.0;
 
 struct HeadingWinding {
-  // From the first record's start to the last record's end.
-  double t0 = 0.0;
-  double t1 = 0.0;
-  int turns = 0;               // Extra turns of the estimate, signed.
-  std::vector<double> excess;  // d_k of the run's records, in order.
+  // One ODOM record of the run: its span and its d_k.
+  struct Step {
+    double t0, t1, excess;
+  };
+  std::vector<Step> steps;  // In time order, each starting where one ended.
+  int turns = 0;            // Extra turns of the estimate, signed.
+  double t0() const { return steps.front().t0; }
+  double t1() const { return steps.back().t1; }
 };
 
 // The windings of `model`'s heading against `dataset`'s ODOM records, in
@@ -55,8 +58,7 @@ std::string DescribeWinding(const HeadingWinding& winding);
 // heading loses the excess of the records so far (linear within a record),
 // after it the run's whole turns, which no residual sees.
 std::vector<TimedPose> UnwindHeadings(
-    const std::vector<HeadingWinding>& windings, const Dataset& dataset,
-    std::vector<TimedPose> poses);
+    const std::vector<HeadingWinding>& windings, std::vector<TimedPose> poses);
 
 // After the solve of `model` (RunSlam's last, the learning's included)
 // that used the odometry, of a model whose mean the solve neither turns

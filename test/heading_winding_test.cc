@@ -21,7 +21,7 @@
 namespace rff {
 namespace {
 
-constexpr double kTwoPi = 2.0 * 3.14159265358979323846;
+constexpr double kTwoPi = 2.0 * M_PI;
 
 // The paper's simulation (1 s steps, an ODOM record per step), 60 poses.
 Dataset Simulated(int observations_per_step) {
@@ -131,14 +131,13 @@ TEST(HeadingWindingTest, FindsATurnTheOdometryDoesNotHaveAndUnwindsIt) {
   const std::vector<HeadingWinding> windings =
       FindHeadingWindings(dataset, *model);
   ASSERT_EQ(windings.size(), 1u);
-  EXPECT_EQ(windings[0].t0, t0);
-  EXPECT_EQ(windings[0].t1, t1);
+  EXPECT_EQ(windings[0].t0(), t0);
+  EXPECT_EQ(windings[0].t1(), t1);
   EXPECT_EQ(windings[0].turns, 1);
-  EXPECT_EQ(windings[0].excess.size(), 12u);
+  EXPECT_EQ(windings[0].steps.size(), 12u);
   EXPECT_EQ(DescribeWinding(windings[0]), "t = 20 to 32: +1 turn");
 
-  const std::vector<TimedPose> unwound =
-      UnwindHeadings(windings, dataset, spun);
+  const std::vector<TimedPose> unwound = UnwindHeadings(windings, spun);
   double largest = 0.0;
   for (std::size_t k = 0; k < truth.size(); ++k) {
     largest = std::max(largest, std::abs(unwound[k].theta - truth[k].theta));
