@@ -16,7 +16,7 @@
 #include "rff_ceres/options.h"
 #include "rff_ceres/priors/trajectory_prior.h"
 #include "rff_ceres/quality_report.h"
-#include "rff_ceres/simulate.h"
+#include "test/paper_dataset.h"
 
 namespace rff {
 namespace {
@@ -25,14 +25,7 @@ constexpr double kTwoPi = 2.0 * M_PI;
 
 // The paper's simulation (1 s steps, an ODOM record per step), 60 poses.
 Dataset Simulated(int observations_per_step) {
-  SimulationOptions simulation = PaperOptions(3);
-  simulation.num_steps = 60;
-  simulation.num_landmarks = 10;
-  simulation.observations_per_step = observations_per_step;
-  Dataset dataset;
-  std::string error;
-  EXPECT_TRUE(Simulate(simulation, &dataset, &error)) << error;
-  return dataset;
+  return testing::PaperDataset(3, 60, 10, observations_per_step);
 }
 
 // The truth with one extra turn spread over [from, to) and kept after.

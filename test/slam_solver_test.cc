@@ -18,6 +18,7 @@
 #include "rff_ceres/metrics.h"
 #include "rff_ceres/priors/trajectory_prior.h"
 #include "rff_ceres/simulate.h"
+#include "test/paper_dataset.h"
 #include "test/synthetic_options.h"
 #include "test/trajectory_difference.h"
 
@@ -27,25 +28,12 @@ namespace {
 using ::testing::EndsWith;
 using ::testing::HasSubstr;
 using testing::LargestPositionDifference;
+using testing::PaperDataset;
 using ::testing::StartsWith;
 
 // Options that work on the paper's simulated protocol (300 s, 1 Hz).
 SlamOptions PaperSolverOptions() {
   return testing::SyntheticRangeBearingOptions();
-}
-
-// The paper's simulator (seed `seed`) with `steps` poses, `landmarks`
-// landmarks and `per_step` observations per pose; empty if it fails.
-Dataset PaperDataset(std::uint64_t seed, int steps, int landmarks,
-                     int per_step) {
-  SimulationOptions sim = PaperOptions(seed);
-  sim.num_steps = steps;
-  sim.num_landmarks = landmarks;
-  sim.observations_per_step = per_step;
-  Dataset dataset;
-  std::string error;
-  EXPECT_TRUE(Simulate(sim, &dataset, &error)) << error;
-  return dataset;
 }
 
 // `options` solved with BANDED_CHOLESKY and with Ceres's sparse Cholesky.

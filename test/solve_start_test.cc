@@ -5,29 +5,17 @@
 #include <string>
 
 #include "gtest/gtest.h"
-#include "rff_ceres/simulate.h"
+#include "test/paper_dataset.h"
 
 namespace rff {
 namespace {
 
-// The paper's simulator, 60 poses with odometry: the RFF prior's default
-// mean is then a WNOA solve of the same data.
-Dataset SmallPaperDataset() {
-  SimulationOptions sim = PaperOptions(3);
-  sim.num_steps = 60;
-  sim.num_landmarks = 10;
-  sim.observations_per_step = 3;
-  Dataset dataset;
-  std::string error;
-  EXPECT_TRUE(Simulate(sim, &dataset, &error)) << error;
-  return dataset;
-}
-
-// With a "wnoa" mean the trajectory starts on the mean (the weights at
+// With a "wnoa" mean (the RFF prior's default on the paper's simulator, 60
+// poses with odometry) the trajectory starts on the mean (the weights at
 // zero) and every landmark at the WNOA solve's estimate, not at a fresh
 // multilateration from the mean's poses.
 TEST(BuildMeanTest, WnoaMeanStartsTheLandmarksAtItsSolve) {
-  const Dataset dataset = SmallPaperDataset();
+  const Dataset dataset = testing::PaperDataset(3, 60, 10, 3);
   ASSERT_FALSE(dataset.odometry.empty());
   SlamOptions options;
   options.solver.num_threads = 1;
