@@ -13,8 +13,8 @@
 namespace rff {
 namespace testing {
 
-// The largest difference of x or y between two solves' trajectories (the
-// same times); infinity if they differ in length.
+// The largest distance between two solves' positions at the same times;
+// infinity if their trajectories differ in length.
 inline double LargestPositionDifference(const SlamResult& a,
                                         const SlamResult& b) {
   if (a.trajectory.size() != b.trajectory.size()) {
@@ -22,9 +22,9 @@ inline double LargestPositionDifference(const SlamResult& a,
   }
   double largest = 0.0;
   for (std::size_t i = 0; i < a.trajectory.size(); ++i) {
-    largest =
-        std::max({largest, std::abs(a.trajectory[i].x - b.trajectory[i].x),
-                  std::abs(a.trajectory[i].y - b.trajectory[i].y)});
+    largest = std::max(largest,
+                       std::hypot(a.trajectory[i].x - b.trajectory[i].x,
+                                  a.trajectory[i].y - b.trajectory[i].y));
   }
   return largest;
 }
