@@ -301,32 +301,101 @@ bool FeatureTrajectory::AddStretch(const FeatureTrajectoryOptions& options,
     Segment s;
     s.begin = k * segment;
     s.end = (k + 1) * segment;
-    FeatureMapOptions map_options;
-    map_options.family = options.family;
-    map_options.num_features_flag = "num_features";
-    // Each segment's maps cover its extent and half the overlap each side.
-    map_options.window_begin = k > 0 ? -0.5 * stretch.overlap : 0.0;
-    map_options.window_end =
+    // Its maps cover its extent and half the overlap each side.
+    s.window_begin = k > 0 ? -0.5 * stretch.overlap : 0.0;
+    s.window_end =
         segment + (k + 1 < num_segments ? 0.5 * stretch.overlap : 0.0);
-    map_options.num_features = options.num_position_features;
-    // The draws restart in each stretch: it solves as it would alone.
-    map_options.seed = options.seed + 2 * k;
-    s.position_map = CreateFeatureMap(*position_kernel_, map_options, error);
-    if (!s.position_map) return false;
-    map_options.num_features = options.num_heading_features;
-    map_options.num_features_flag = "num_heading_features";
-    map_options.seed = options.seed + 2 * k + 1;  // Independent draws.
-    s.heading_map = CreateFeatureMap(*heading_kernel_, map_options, error);
-    if (!s.heading_map) return false;
-    for (const int size :
-         {s.position_map->num_features(), s.position_map->num_features(),
-          s.heading_map->num_features()}) {
-      offsets_.push_back(offsets_.back() + size);
+    if (!AddSegment(options, k, options.num_position_features,
+                    options.num_heading_features, std::move(s), error)) {
+      return false;
     }
-    segments_.push_back(std::move(s));
   }
   stretches_.push_back(stretch);
   return true;
+}
+
+bool FeatureTrajectory::AddSegment(const FeatureTrajectoryOptions& options,
+                                   int k, int num_position_features,
+                                   int num_heading_features, Segment segment,
+                                   std::string* error) {
+  FeatureMapOptions map_options;
+  map_options.family = options.family;
+  map_options.num_features_flag = "num_features";
+  map_options.window_begin = segment.window_begin;
+  map_options.window_end = segment.window_end;
+  map_options.num_features = num_position_features;
+  // The draws restart in each stretch: it solves as it would alone.
+  map_options.seed = options.seed + 2 * k;
+  segment.position_map =
+      CreateFeatureMap(*position_kernel_, map_options, error);
+  if (!segment.position_map) return false;
+  map_options.num_features = num_heading_features;
+  map_options.num_features_flag = "num_heading_features";
+  map_options.seed = options.seed + 2 * k + 1;  // Independent draws.
+  segment.heading_map = CreateFeatureMap(*heading_kernel_, map_options, error);
+  if (!segment.heading_map) return false;
+  for (const int size : {segment.position_map->num_features(),
+                         segment.position_map->num_features(),
+                         segment.heading_map->num_features()}) {
+    offsets_.push_back(offsets_.back() + size);
+  }
+  segments_.push_back(std::move(segment));
+  return true;
+}
+
+std::unique_ptr<FeatureTrajectory> FeatureTrajectory::WithMoreModes(
+    double tail_fraction, int most_multiple, std::string* error) const {
+  if (options_.family != "hilbert") {
+    *error = "more modes of the same basis need the hilbert family, not " +
+             options_.family;
+    return nullptr;
+  }
+  for (const Segment& segment : segments_) {
+    if (!dynamic_cast<const HilbertFeatures*>(segment.position_map.get()) ||
+        !dynamic_cast<const HilbertFeatures*>(segment.heading_map.get())) {
+      *error = "more modes need Hilbert maps (a kernel with a density)";
+      return nullptr;
+    }
+  }
+  // D' of a map of `kernel` with D modes.
+  auto modes = [&](const FeatureMap& map, const Kernel& kernel) {
+    const int d = map.num_features();
+    return HilbertModesForTail(
+        kernel, static_cast<const HilbertFeatures&>(map).half_width(), d,
+        tail_fraction, std::max(d + 1, most_multiple * d));
+  };
+  std::unique_ptr<FeatureTrajectory> model(new FeatureTrajectory);
+  model->options_ = options_;
+  model->mean_ = mean_;
+  model->reach_ = reach_;
+  model->position_kernel_ = CreateKernel(options_.position_kernel, error);
+  model->heading_kernel_ =
+      CreateKernel(options_.heading_kernel, error, "heading_");
+  if (!model->position_kernel_ || !model->heading_kernel_) return nullptr;
+  model->stretches_ = stretches_;
+  for (const Stretch& stretch : stretches_) {
+    for (int k = 0; k < stretch.num_segments; ++k) {
+      const Segment& old = segments_[stretch.first_segment + k];
+      Segment segment;
+      segment.begin = old.begin;
+      segment.end = old.end;
+      segment.window_begin = old.window_begin;
+      segment.window_end = old.window_end;
+      if (!model->AddSegment(options_, k,
+                             modes(*old.position_map, *position_kernel_),
+                             modes(*old.heading_map, *heading_kernel_),
+                             std::move(segment), error)) {
+        return nullptr;
+      }
+    }
+  }
+  // This model's weights first in each block, the new modes' at zero.
+  model->weights_ = Eigen::VectorXd::Zero(model->offsets_.back());
+  for (int b = 0; b < num_blocks(); ++b) {
+    model->weights_.segment(model->offsets_[b], block_size(b)) =
+        weights_.segment(offsets_[b], block_size(b));
+  }
+  return model;
 }
 
 const std::vector<FeatureTrajectory::Features>& FeatureTrajectory::FeaturesAt(

@@ -140,6 +140,16 @@ class FeatureTrajectory : public TrajectoryModel {
   // problem's pose maps share, is evaluated again in place.
   bool AdoptScales(TrajectoryModel* rescaled) override;
 
+  // The same model with more modes in every feature map: each Hilbert map
+  // gains the next eigenfunctions of its domain until the spectral mass it
+  // misses is `tail_fraction` of what it missed (HilbertModesForTail), at
+  // most `most_multiple` times its modes. Each block's first features (and
+  // weights) are this model's; the new weights are zero. nullptr and
+  // `error` for other families.
+  std::unique_ptr<FeatureTrajectory> WithMoreModes(double tail_fraction,
+                                                   int most_multiple,
+                                                   std::string* error) const;
+
  private:
   // Create; `any_run`: `times` stand for any run (CheckOptions).
   static std::unique_ptr<FeatureTrajectory> Build(
@@ -163,6 +173,10 @@ class FeatureTrajectory : public TrajectoryModel {
   struct Segment {
     double begin = 0.0;  // Nominal extent, relative to its stretch's begin.
     double end = 0.0;
+    // The maps' window, relative to `begin`: the extent and half the overlap
+    // each side that has a neighbour.
+    double window_begin = 0.0;
+    double window_end = 0.0;
     // Of times relative to `begin`: the feature maps keep their precision
     // however long the run.
     std::unique_ptr<FeatureMap> position_map, heading_map;
@@ -176,6 +190,11 @@ class FeatureTrajectory : public TrajectoryModel {
   };
   const std::vector<Features>& FeaturesAt(double t) const;
   std::vector<Features> EvaluateFeatures(double t) const;
+  // Appends `segment`, the k-th of its stretch, with maps of the given sizes
+  // over its window, and its three weight blocks.
+  bool AddSegment(const FeatureTrajectoryOptions& options, int k,
+                  int num_position_features, int num_heading_features,
+                  Segment segment, std::string* error);
   // Appends the segments of one stretch of `data`, `length` seconds long.
   bool AddStretch(const FeatureTrajectoryOptions& options,
                   const TimeInterval& data, double length, std::string* error);

@@ -69,6 +69,9 @@ struct OutputOptions {
   // Posterior covariance of every output pose and landmark (see
   // posterior_covariance.h); for at most kMaxCovarianceLandmarks landmarks.
   bool covariance = false;
+  // With it, what a feature basis's truncation adds (truncation_covariance.h):
+  // off, the Laplace covariance of the truncated model alone.
+  bool covariance_truncation = true;
   // The quality verdict (quality_report.h). Off only for the WNOA solve an
   // RFF prior's mean or start comes from: the RFF solve judges its own.
   bool quality = true;

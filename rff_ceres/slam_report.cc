@@ -70,6 +70,10 @@ void PrintSlamSummary(const SlamOptions& options, const SlamResult& result,
     }
     *out << "): solved again from it unwound\n";
   }
+  if (!result.covariance_truncation.empty()) {
+    *out << "  covariance   the basis's truncation term: "
+         << result.covariance_truncation << "\n";
+  }
   if (!result.noise_learned.empty()) {
     *out << "  noise        sigmas learned as the stated ones times:";
     const char* separator = " ";
@@ -193,6 +197,8 @@ void WriteSummaryJson(const SlamOptions& options, const SlamResult& result,
       << JsonStringArray(result.heading_windings_unwound) << ",\n"
       << "  \"heading_windings\": " << JsonStringArray(result.heading_windings)
       << ",\n"
+      << "  \"covariance_truncation\": "
+      << JsonString(result.covariance_truncation) << ",\n"
       << "  \"noise_scales_kept\": " << JsonStringArray(result.noise_kept)
       << ",\n"
       << "  \"noise_scales_learned\": " << JsonStringArray(result.noise_learned)

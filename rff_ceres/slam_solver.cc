@@ -20,6 +20,8 @@
 #include "rff_ceres/priors/trajectory_prior.h"
 #include "rff_ceres/scale_learning.h"
 #include "rff_ceres/solve_start.h"
+#include "rff_ceres/truncation_covariance.h"
+#include "rff_ceres/variance_components.h"
 
 namespace rff {
 
@@ -151,10 +153,28 @@ bool CheckData(const Dataset& dataset, const SlamOptions& options,
   return true;
 }
 
+// The prior's scales the learning left a variance: not at zero.
+std::set<TrajectoryModel::PriorScale> ScalesWithVariance(
+    const SlamResult& result) {
+  std::set<TrajectoryModel::PriorScale> scales;
+  for (const auto& [scale, group] :
+       {std::pair(TrajectoryModel::PriorScale::kPosition,
+                  VarianceGroup::kPriorPosition),
+        std::pair(TrajectoryModel::PriorScale::kHeading,
+                  VarianceGroup::kPriorHeading)}) {
+    const std::vector<std::string>& zero = result.scales_at_boundary;
+    if (std::find(zero.begin(), zero.end(), VarianceGroupName(group)) ==
+        zero.end()) {
+      scales.insert(scale);
+    }
+  }
+  return scales;
+}
+
 // Fills `result` from the solved problem: the losses and models as
 // settled, the quality verdict, the landmarks and, when asked, the
 // covariances.
-bool ReportSolution(const SlamOptions& options,
+bool ReportSolution(const Dataset& dataset, const SlamOptions& options,
                     const SlamResult& wnoa_mean_solve,
                     const TrajectoryModel& model,
                     const std::map<LandmarkId, Eigen::Vector2d>& landmarks,
@@ -207,10 +227,23 @@ bool ReportSolution(const SlamOptions& options,
     covariance_options.num_threads = options.solver.num_threads;
     if (!ComputePosteriorCovariance(problem, model, times, covariance_options,
                                     &result->pose_covariances,
-                                    &result->landmarks, error) ||
-        !AddMeanCovariance(wnoa_mean_solve, result, error)) {
+                                    &result->landmarks, error)) {
       return false;
     }
+    if (!PriorOf(options).has_features()) {
+      // Markov states truncate nothing.
+    } else if (!options.output.covariance_truncation) {
+      result->covariance_truncation = "none: not asked for";
+    } else if (options.incremental.every > 0) {
+      result->covariance_truncation = "none: an incremental solve";
+    } else if (!AddTruncationCovariance(
+                   dataset, settled->problem, problem, model,
+                   ScalesWithVariance(*result), times,
+                   &result->pose_covariances, &result->landmarks,
+                   &result->covariance_truncation, error)) {
+      return false;
+    }
+    if (!AddMeanCovariance(wnoa_mean_solve, result, error)) return false;
   }
   return true;
 }
@@ -366,8 +399,8 @@ bool RunSlamAtOrigin(const Dataset& dataset, const SlamOptions& options,
       result->heading_windings.push_back(DescribeWinding(w));
     }
   }
-  if (!ReportSolution(options, wnoa_mean_solve, *model, landmarks, &settled,
-                      problem.get(), result, error)) {
+  if (!ReportSolution(dataset, options, wnoa_mean_solve, *model, landmarks,
+                      &settled, problem.get(), result, error)) {
     return false;
   }
   result->solve_seconds =

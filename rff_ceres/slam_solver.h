@@ -42,6 +42,9 @@ struct SlamResult {
   // With output.covariance: the covariance of (x, y, theta) at each
   // trajectory time, and has_covariance set on every landmark.
   std::vector<Eigen::Matrix3d> pose_covariances;
+  // What the feature basis's truncation added to them
+  // (truncation_covariance.h), or why nothing.
+  std::string covariance_truncation;
   ceres::Solver::Summary summary;          // Of the last solve.
   int total_iterations = 0;                // Over all outer rounds.
   double solve_seconds = 0.0;              // Wall time of the whole RunSlam.

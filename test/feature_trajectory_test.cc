@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "gtest/gtest.h"
+#include "rff_ceres/features/hilbert_features.h"
 #include "rff_ceres/kernels/kernel.h"
 #include "rff_ceres/mean/mean_function.h"
 
@@ -307,6 +308,66 @@ TEST(FeatureTrajectoryTest, AdoptScalesRewritesSharedFeaturesInPlace) {
   ASSERT_NE(other, nullptr) << error;
   EXPECT_FALSE(model->AdoptScales(other.get()));
   EXPECT_TRUE(*held[1].terms[0].phi == *expected[1].terms[0].phi);
+}
+
+// More modes of the same basis: each block grows by the next modes of its
+// Hilbert domain until the missed spectral mass is a twentieth of the
+// basis's (the fewest that do); the first features of every map and all
+// weights are the model's, so its poses are too.
+TEST(FeatureTrajectoryTest, MoreModesKeepTheModelsFeaturesAndPoses) {
+  std::string error;
+  auto model = FeatureTrajectory::Create(WindowedOptions(12), ZeroMean(), 0.0,
+                                         100.0, &error);
+  ASSERT_NE(model, nullptr) << error;
+  RandomizeWeights(model.get(), 11);
+  auto wider = model->WithMoreModes(0.05, 4, &error);
+  ASSERT_NE(wider, nullptr) << error;
+  ASSERT_EQ(wider->num_blocks(), model->num_blocks());
+  for (int b = 0; b < model->num_blocks(); ++b) {
+    const int d = model->block_size(b);
+    EXPECT_GT(wider->block_size(b), d) << b;
+    EXPECT_LE(wider->block_size(b), 4 * d) << b;
+    for (int i = 0; i < wider->block_size(b); ++i) {
+      EXPECT_EQ(wider->block(b)[i], i < d ? model->block(b)[i] : 0.0);
+    }
+  }
+  for (double t = -2.0; t < 102.0; t += 0.9) {
+    EXPECT_LT((wider->Pose(t) - model->Pose(t)).norm(), 1e-12) << t;
+    const PoseMap narrow = model->PoseAt(t), wide = wider->PoseAt(t);
+    ASSERT_EQ(wide.terms.size(), narrow.terms.size()) << t;
+    for (std::size_t k = 0; k < narrow.terms.size(); ++k) {
+      const Eigen::VectorXd& phi = *narrow.terms[k].phi;
+      EXPECT_TRUE(wide.terms[k].phi->head(phi.size()) == phi) << t;
+    }
+  }
+  // The fewest modes that miss a twentieth: of the x block of the first
+  // segment (rbf, 3 s), on the domain its map has.
+  std::string kernel_error;
+  const std::unique_ptr<Kernel> kernel =
+      CreateKernel({"rbf", 4.0, 3.0}, &kernel_error);
+  ASSERT_NE(kernel, nullptr) << kernel_error;
+  FeatureMapOptions map;
+  map.window_begin = 0.0;
+  map.window_end = 24.0;  // 20 s and half the 8 s overlap.
+  const double half_width = HilbertHalfWidth(*kernel, map);
+  auto tail = [&](int modes) {
+    return 1.0 -
+           kernel->FrequencyCdf(M_PI * (modes + 0.5) / (2.0 * half_width));
+  };
+  const int modes = wider->block_size(0);
+  EXPECT_EQ(modes, HilbertModesForTail(*kernel, half_width, 12, 0.05, 48));
+  EXPECT_LE(tail(modes), 0.05 * tail(12));
+  EXPECT_GT(tail(modes - 1), 0.05 * tail(12));
+
+  // Random features have no next modes.
+  FeatureTrajectoryOptions random = WindowedOptions(12);
+  random.family = "rff";
+  auto drawn =
+      FeatureTrajectory::Create(random, ZeroMean(), 0.0, 100.0, &error);
+  ASSERT_NE(drawn, nullptr) << error;
+  EXPECT_EQ(drawn->WithMoreModes(0.05, 4, &error), nullptr);
+  EXPECT_EQ(error,
+            "more modes of the same basis need the hilbert family, not rff");
 }
 
 }  // namespace

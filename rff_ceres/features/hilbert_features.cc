@@ -41,6 +41,19 @@ int HilbertNumFeatures(const Kernel& kernel, const FeatureMapOptions& options,
   return std::max(1, static_cast<int>(std::ceil(d)));
 }
 
+int HilbertModesForTail(const Kernel& kernel, double half_width, int d,
+                        double fraction, int most) {
+  auto tail = [&](int modes) {
+    return 1.0 - kernel.FrequencyCdf(M_PI * (modes + 0.5) / (2.0 * half_width));
+  };
+  // Below rounding the basis misses nothing: one more mode says so.
+  if (!(tail(d) > 1e-12)) return std::min(d + 1, most);
+  const double target = fraction * tail(d);
+  int modes = d + 1;
+  while (modes < most && tail(modes) > target) ++modes;
+  return std::min(modes, most);
+}
+
 std::unique_ptr<FeatureMap> CreateHilbertFeatures(
     const Kernel& kernel, const FeatureMapOptions& options,
     std::string* /*error*/) {

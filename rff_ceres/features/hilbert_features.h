@@ -48,6 +48,12 @@ double HilbertHalfWidth(const Kernel& kernel, const FeatureMapOptions& options);
 int HilbertNumFeatures(const Kernel& kernel, const FeatureMapOptions& options,
                        double tolerance);
 
+// The number of modes D' > D of a map on [centre - L, centre + L] whose
+// missed spectral mass, 1 - P(pi (D' + 1/2) / (2 L)) of the normalised
+// density, is at most `fraction` of D's; at most `most`.
+int HilbertModesForTail(const Kernel& kernel, double half_width, int d,
+                        double fraction, int most);
+
 std::unique_ptr<FeatureMap> CreateHilbertFeatures(
     const Kernel& kernel, const FeatureMapOptions& options, std::string* error);
 
