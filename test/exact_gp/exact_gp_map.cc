@@ -12,6 +12,7 @@
 #include "costs/bearing_cost.h"
 #include "costs/range_cost.h"
 #include "rff_ceres/io/text_parser.h"
+#include "rff_ceres/simulate_gp_draw.h"
 
 namespace rff {
 namespace {
@@ -468,6 +469,18 @@ bool SolveExactGpMap(
     result->landmarks.push_back(l);
   }
   return true;
+}
+
+bool SetTruthKernels(const Dataset& dataset, ExactGpOptions* options,
+                     std::string* error) {
+  for (const auto& [key, value] : dataset.metadata) {
+    if (key == "truth") {
+      return ParseGpDrawTruth(value, &options->position_kernel,
+                              &options->heading_kernel, error);
+    }
+  }
+  *error = "the dataset has no '# truth:' line";
+  return false;
 }
 
 bool SolveExactGpMapFromGroundTruth(const Dataset& dataset,

@@ -95,6 +95,11 @@ bool SolveExactGpMap(const Dataset& dataset, const ExactGpOptions& options,
 bool PositionNees(const Dataset& dataset, const ExactGpResult& result,
                   double* nees, std::string* error);
 
+// The kernels of a gp_draw dataset's "# truth:" metadata (ParseGpDrawTruth)
+// into `options`. False and `error` where it has none or it does not parse.
+bool SetTruthKernels(const Dataset& dataset, ExactGpOptions* options,
+                     std::string* error);
+
 // Both together: starts from the ground truth, solves, and evaluates the
 // estimate against the ground truth (unaligned, as rff_evaluate by default).
 bool SolveExactGpMapFromGroundTruth(const Dataset& dataset,

@@ -34,13 +34,8 @@ Dataset SmallDraw(std::uint64_t seed, int num_steps,
 ExactGpOptions TruthOptions(const Dataset& dataset, const std::string& mean) {
   ExactGpOptions options;
   options.mean = mean;
-  std::string truth, error;
-  for (const auto& [key, value] : dataset.metadata) {
-    if (key == "truth") truth = value;
-  }
-  EXPECT_TRUE(ParseGpDrawTruth(truth, &options.position_kernel,
-                               &options.heading_kernel, &error))
-      << error;
+  std::string error;
+  EXPECT_TRUE(SetTruthKernels(dataset, &options, &error)) << error;
   return options;
 }
 

@@ -36,13 +36,8 @@ Dataset KnownMapDraw(std::uint64_t seed, const std::string& kernel,
 
 ExactGpOptions Truth(const Dataset& dataset) {
   ExactGpOptions options;
-  std::string truth, error;
-  for (const auto& [key, value] : dataset.metadata) {
-    if (key == "truth") truth = value;
-  }
-  EXPECT_TRUE(ParseGpDrawTruth(truth, &options.position_kernel,
-                               &options.heading_kernel, &error))
-      << error;
+  std::string error;
+  EXPECT_TRUE(SetTruthKernels(dataset, &options, &error)) << error;
   return options;
 }
 
