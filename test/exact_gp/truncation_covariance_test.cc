@@ -87,6 +87,7 @@ TEST(TruncationCovarianceTest, DefaultRffIsAsConsistentAsTheExactGp) {
     ASSERT_TRUE(SolveExactGpMapFromGroundTruth(dataset, exact_options, &exact,
                                                &exact_evaluation, &error))
         << error;
+    ASSERT_TRUE(exact.converged) << exact.gradient_max_norm;
     double exact_nees = 0.0;
     ASSERT_TRUE(PositionNees(dataset, exact, &exact_nees, &error)) << error;
 
