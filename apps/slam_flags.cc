@@ -148,6 +148,11 @@ DEFINE_bool(estimate_odometry_calibration, false,
 DEFINE_double(odometry_scale_sigma, 0.1,
               "Prior sigma of both odometry scales around 1, more than 0.");
 DEFINE_bool(use_odometry, true, "Add the ODOM records as residuals.");
+DEFINE_bool(covariance_truncation, true,
+            "With the covariance, add the motion the RFF prior's Hilbert "
+            "basis leaves out, through the estimate's response to its next "
+            "modes (docs/uncertainty.md); false: the truncated model's "
+            "Laplace covariance alone.");
 DEFINE_bool(preintegrate_odometry, true,
             "Compose ODOM chains between observation times into one residual "
             "each (first-order covariance).");
@@ -261,6 +266,7 @@ SlamOptions SlamOptionsFromFlags() {
   options.problem.odometry_loss.name = FLAGS_odometry_loss;
   options.problem.odometry_loss.scale = FLAGS_odometry_loss_scale;
   options.problem.use_odometry = FLAGS_use_odometry;
+  options.output.covariance_truncation = FLAGS_covariance_truncation;
   RangeCalibrationOptions& calibration = options.problem.range_calibration;
   calibration.estimate = FLAGS_estimate_range_calibration;
   calibration.scale_sigma = FLAGS_range_scale_sigma;

@@ -343,34 +343,28 @@ bool FeatureTrajectory::AddSegment(const FeatureTrajectoryOptions& options,
   return true;
 }
 
-std::unique_ptr<FeatureTrajectory> FeatureTrajectory::WithMoreModes(
-    double tail_fraction, int most_multiple, std::string* error) const {
+std::unique_ptr<TrajectoryModel> FeatureTrajectory::WithMoreModes(
+    double tail_fraction, int most_multiple, std::string* why) const {
   if (options_.family != "hilbert") {
-    *error = "more modes of the same basis need the hilbert family, not " +
-             options_.family;
+    *why = "more modes of the same basis need the hilbert family, not " +
+           options_.family;
     return nullptr;
   }
-  for (const Segment& segment : segments_) {
-    if (!dynamic_cast<const HilbertFeatures*>(segment.position_map.get()) ||
-        !dynamic_cast<const HilbertFeatures*>(segment.heading_map.get())) {
-      *error = "more modes need Hilbert maps (a kernel with a density)";
-      return nullptr;
-    }
-  }
-  // D' of a map of `kernel` with D modes.
+  // D' of a map of `kernel` with D modes; D for a map of another kind.
   auto modes = [&](const FeatureMap& map, const Kernel& kernel) {
     const int d = map.num_features();
-    return HilbertModesForTail(
-        kernel, static_cast<const HilbertFeatures&>(map).half_width(), d,
-        tail_fraction, std::max(d + 1, most_multiple * d));
+    const auto* hilbert = dynamic_cast<const HilbertFeatures*>(&map);
+    if (hilbert == nullptr) return d;
+    return HilbertModesForTail(kernel, hilbert->half_width(), d, tail_fraction,
+                               std::max(d + 1, most_multiple * d));
   };
   std::unique_ptr<FeatureTrajectory> model(new FeatureTrajectory);
   model->options_ = options_;
   model->mean_ = mean_;
   model->reach_ = reach_;
-  model->position_kernel_ = CreateKernel(options_.position_kernel, error);
+  model->position_kernel_ = CreateKernel(options_.position_kernel, why);
   model->heading_kernel_ =
-      CreateKernel(options_.heading_kernel, error, "heading_");
+      CreateKernel(options_.heading_kernel, why, "heading_");
   if (!model->position_kernel_ || !model->heading_kernel_) return nullptr;
   model->stretches_ = stretches_;
   for (const Stretch& stretch : stretches_) {
@@ -384,10 +378,14 @@ std::unique_ptr<FeatureTrajectory> FeatureTrajectory::WithMoreModes(
       if (!model->AddSegment(options_, k,
                              modes(*old.position_map, *position_kernel_),
                              modes(*old.heading_map, *heading_kernel_),
-                             std::move(segment), error)) {
+                             std::move(segment), why)) {
         return nullptr;
       }
     }
+  }
+  if (model->offsets_ == offsets_) {
+    *why = "no map of the basis has modes to add (no kernel with a density)";
+    return nullptr;
   }
   // This model's weights first in each block, the new modes' at zero.
   model->weights_ = Eigen::VectorXd::Zero(model->offsets_.back());

@@ -140,15 +140,11 @@ class FeatureTrajectory : public TrajectoryModel {
   // problem's pose maps share, is evaluated again in place.
   bool AdoptScales(TrajectoryModel* rescaled) override;
 
-  // The same model with more modes in every feature map: each Hilbert map
-  // gains the next eigenfunctions of its domain until the spectral mass it
-  // misses is `tail_fraction` of what it missed (HilbertModesForTail), at
-  // most `most_multiple` times its modes. Each block's first features (and
-  // weights) are this model's; the new weights are zero. nullptr and
-  // `error` for other families.
-  std::unique_ptr<FeatureTrajectory> WithMoreModes(double tail_fraction,
-                                                   int most_multiple,
-                                                   std::string* error) const;
+  // Each Hilbert map gains its next eigenfunctions (HilbertModesForTail);
+  // a map of another kind (a kernel without a density) keeps its features.
+  // nullptr and `why` for other families.
+  std::unique_ptr<TrajectoryModel> WithMoreModes(
+      double tail_fraction, int most_multiple, std::string* why) const override;
 
  private:
   // Create; `any_run`: `times` stand for any run (CheckOptions).

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
+#include <utility>
 
 #include "Eigen/Geometry"
 #include "costs/diagonal_prior_cost.h"
@@ -29,6 +31,17 @@ MeanRotationTrajectory::MeanRotationTrajectory(
       mean_(std::move(mean)),
       anchor_time_(anchor_time),
       sigma_(sigma) {}
+
+std::unique_ptr<TrajectoryModel> MeanRotationTrajectory::WithMoreModes(
+    double tail_fraction, int most_multiple, std::string* why) const {
+  std::unique_ptr<TrajectoryModel> inner =
+      inner_->WithMoreModes(tail_fraction, most_multiple, why);
+  if (!inner) return nullptr;
+  auto model = std::make_unique<MeanRotationTrajectory>(std::move(inner), mean_,
+                                                        anchor_time_, sigma_);
+  model->delta_ = delta_;
+  return model;
+}
 
 PoseMap MeanRotationTrajectory::PoseAt(double t) const {
   PoseMap map = inner_->PoseAt(t);

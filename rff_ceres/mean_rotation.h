@@ -75,6 +75,9 @@ class MeanRotationTrajectory : public TrajectoryModel {
     inner_->UpdatePriorCosts(costs);
   }
 
+  // The inner model's, turned about the same anchor by the same delta.
+  std::unique_ptr<TrajectoryModel> WithMoreModes(
+      double tail_fraction, int most_multiple, std::string* why) const override;
   TrajectoryModel* inner() { return inner_.get(); }
   const TrajectoryModel* inner() const { return inner_.get(); }
   double delta() const { return delta_; }

@@ -86,6 +86,17 @@ class TrajectoryModel {
   // bit and the blocks keep their values. False, nothing changed, where
   // the structure differs or the model cannot (the default).
   virtual bool AdoptScales(TrajectoryModel* /*rescaled*/) { return false; }
+  // The same model with more modes of its basis where it has an ordered one
+  // (Hilbert features, FeatureTrajectory): each map gains its next modes
+  // until the spectral mass it misses is `tail_fraction` of what it missed,
+  // at most `most_multiple` times its modes. Its blocks are this model's in
+  // number and order, each holding this model's values first and the new
+  // modes at zero. nullptr and `why` otherwise (the default).
+  virtual std::unique_ptr<TrajectoryModel> WithMoreModes(
+      double /*tail_fraction*/, int /*most_multiple*/, std::string* why) const {
+    *why = "the model has no basis to extend";
+    return nullptr;
+  }
   // Gives `costs`, those AddPriorCosts added to a problem, the prior the
   // model's scales now say (after AdoptScales): each then equals the cost
   // AddPriorCosts would add. Nothing where the prior has no scale.

@@ -9,7 +9,7 @@
 
 #include "Eigen/Cholesky"
 #include "Eigen/SparseCore"
-#include "rff_ceres/feature_trajectory.h"
+#include "rff_ceres/gauss_newton_system.h"
 #include "rff_ceres/io/text_parser.h"
 #include "rff_ceres/variance_components.h"
 
@@ -85,28 +85,23 @@ void SplitJacobian(const Eigen::SparseMatrix<double, Eigen::RowMajor>& jacobian,
 
 }  // namespace
 
-bool AddTruncationCovariance(
+void AddTruncationCovariance(
     const Dataset& dataset, const ProblemOptions& options, SlamProblem* problem,
     const TrajectoryModel& model,
     const std::set<TrajectoryModel::PriorScale>& scales,
     const std::vector<double>& times,
     std::vector<Eigen::Matrix3d>* pose_covariances,
-    std::vector<Landmark>* landmarks, std::string* note, std::string* error) {
-  const auto* features = dynamic_cast<const FeatureTrajectory*>(&model);
-  if (features == nullptr || features->options().family != "hilbert") {
-    *note = "none: not a Hilbert feature basis";
-    return true;
-  }
+    std::vector<Landmark>* landmarks, std::string* note) {
   if (scales.empty()) {
     *note = "none: the data leave the prior no variance";
-    return true;
+    return;
   }
   std::string why;
-  std::unique_ptr<FeatureTrajectory> extended = features->WithMoreModes(
+  const std::unique_ptr<TrajectoryModel> extended = model.WithMoreModes(
       kTruncationTailFraction, kTruncationMostModeMultiple, &why);
   if (!extended) {
     *note = "none: " + why;
-    return true;
+    return;
   }
   // A dense LLT of H, its solves for the new modes, and every pose's two
   // segments' features through them.
@@ -125,12 +120,13 @@ bool AddTruncationCovariance(
     *note = "none: " + FormatNumber(m) + " more modes over " + FormatNumber(n) +
             " parameters cost more than " + FormatNumber(kMaxTruncationWork) +
             " multiply-adds";
-    return true;
+    return;
   }
   SlamProblem wide(extended.get(), options);
-  if (!wide.Build(dataset, problem->landmarks(), error)) {
-    *error = "the truncation term's problem: " + *error;
-    return false;
+  std::string error;
+  if (!wide.Build(dataset, problem->landmarks(), &error)) {
+    *note = "none: the extended problem: " + error;
+    return;
   }
   wide.set_range_calibration(problem->range_calibration());
   wide.set_odometry_calibration(problem->odometry_calibration());
@@ -141,40 +137,52 @@ bool AddTruncationCovariance(
   for (double* block : blocks) {
     if (ceres_problem->IsParameterBlockConstant(block)) {
       *note = "none: a parameter block is held constant";
-      return true;
+      return;
     }
   }
   const ColumnSplit split =
       SplitColumns(ceres_problem, blocks, model, *extended, scales);
+  if (split.num_new == 0) {
+    *note = "none: no new modes of a scale with variance";
+    return;
+  }
   std::vector<ceres::ResidualBlockId> ids;
   ceres_problem->GetResidualBlocks(&ids);
   double cost = 0.0, solved_cost = 0.0;
   Eigen::VectorXd residuals;
   Eigen::SparseMatrix<double, Eigen::RowMajor> jacobian;
-  if (!Linearize(ceres_problem, ids, &cost, &residuals, &jacobian, error,
+  if (!Linearize(ceres_problem, ids, &cost, &residuals, &jacobian, &error,
                  blocks) ||
       !problem->problem()->Evaluate(ceres::Problem::EvaluateOptions(),
                                     &solved_cost, nullptr, nullptr, nullptr)) {
-    *error = "the truncation term's problem cannot be evaluated: " + *error;
-    return false;
+    *note = "none: the extended problem cannot be evaluated: " + error;
+    return;
   }
-  // The new modes are at zero: the same residuals as the solve's.
+  // The new modes are at zero: the same residuals as the solve's, but for
+  // the order of the sums over the longer feature vectors.
   if (!(std::abs(cost - solved_cost) <= 1e-9 * (1.0 + solved_cost))) {
-    *error = "the truncation term's problem has the cost " +
-             FormatNumber(cost) + ", not the solved " +
-             FormatNumber(solved_cost);
-    return false;
+    *note = "none: the extended problem's cost " + FormatNumber(cost) +
+            " is not the solved " + FormatNumber(solved_cost);
+    return;
   }
   ColumnMajorSparse kept, added;
   SplitJacobian(jacobian, split, &kept, &added);
   const Eigen::LLT<Eigen::MatrixXd> factor(
       Eigen::MatrixXd(kept.transpose() * kept));
-  if (factor.info() != Eigen::Success) {
-    *note = "none: J^T J has no dense Cholesky factor (singular to rounding)";
-    return true;
+  if (factor.info() != Eigen::Success ||
+      !(factor.rcond() > kMinReciprocalCondition)) {
+    *note = "none: J^T J is singular to rounding";
+    return;
   }
-  // G = H^-1 J_theta^T J_c.
-  Eigen::MatrixXd response = kept.transpose() * added;
+  // G = H^-1 J_theta^T J_c, a panel of new modes at a time (J_c dense).
+  Eigen::MatrixXd response(split.num_kept, split.num_new);
+  const ColumnMajorSparse kept_transposed = kept.transpose();
+  constexpr int kPanel = 256;
+  for (int first = 0; first < split.num_new; first += kPanel) {
+    const int width = std::min(kPanel, split.num_new - first);
+    response.middleCols(first, width) =
+        kept_transposed * Eigen::MatrixXd(added.middleCols(first, width));
+  }
   factor.solveInPlace(response);
 
   // Rows 3k .. 3k + 2 of A: A(t_k) = Phi(t_k) G_b - Psi(t_k), the kept
@@ -214,8 +222,12 @@ bool AddTruncationCovariance(
     l.syy += added_covariance(1, 1);
   }
   *note = "added: the next " + std::to_string(split.num_new) +
-          " modes of the basis";
-  return true;
+          " modes of the basis (" +
+          (scales.size() == 2 ? "position and heading"
+           : scales.count(TrajectoryModel::PriorScale::kPosition)
+               ? "position; heading has no variance"
+               : "heading; position has no variance") +
+          ")";
 }
 
 }  // namespace rff

@@ -48,17 +48,17 @@ inline constexpr double kMaxTruncationEntries = 67108864.0;  // 512 MB.
 // landmark's covariance in `landmarks`, for `problem`, solved over `model`
 // with `options` from `dataset`, with the new modes of the prior's `scales`
 // (position, heading): a scale the data left no variance (learned at zero)
-// misses no motion either. `note` says what was added, or why nothing was
-// (not a Hilbert feature model; no scale; too large; H singular to a dense
-// Cholesky). False and `error` where the extended problem cannot be built
-// or does not reproduce the solved one's cost.
-bool AddTruncationCovariance(
+// misses no motion either. `note` says what was added or why nothing was:
+// no basis to extend (WNOA states, random features), no scale, too large,
+// H singular to rounding, or an extended problem that does not reproduce
+// the solved one (the covariance is then the truncated model's alone).
+void AddTruncationCovariance(
     const Dataset& dataset, const ProblemOptions& options, SlamProblem* problem,
     const TrajectoryModel& model,
     const std::set<TrajectoryModel::PriorScale>& scales,
     const std::vector<double>& times,
     std::vector<Eigen::Matrix3d>* pose_covariances,
-    std::vector<Landmark>* landmarks, std::string* note, std::string* error);
+    std::vector<Landmark>* landmarks, std::string* note);
 
 }  // namespace rff
 

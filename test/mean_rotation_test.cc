@@ -8,6 +8,7 @@
 #include "Eigen/Geometry"
 #include "costs/wnoa_prior_cost.h"
 #include "gtest/gtest.h"
+#include "rff_ceres/feature_trajectory.h"
 #include "rff_ceres/metrics.h"
 #include "rff_ceres/simulate.h"
 #include "rff_ceres/slam_solver.h"
@@ -53,6 +54,33 @@ TEST(MeanRotationTest, DeltaTurnsTheMeanToFirstOrder) {
   EXPECT_NEAR(after.z() - before.z(), 0.02, 1e-12);
   // At the anchor the position does not move.
   EXPECT_NEAR(model->Pose(0.0).x(), mean.Evaluate(0.0).x(), 1e-12);
+}
+
+// More modes of a rotated feature model: the inner model's, turned by the
+// same delta (the wrapper's first block), so the poses are this model's;
+// WNOA states have no basis to extend.
+TEST(MeanRotationTest, MoreModesKeepTheRotation) {
+  std::string error;
+  auto mean = std::make_shared<ArcMean>();
+  FeatureTrajectoryOptions options;
+  options.num_position_features = 10;
+  options.num_heading_features = 10;
+  auto inner = FeatureTrajectory::Create(options, mean, 0.0, 30.0, &error);
+  ASSERT_NE(inner, nullptr) << error;
+  inner->mutable_block(0)[3] = 0.4;
+  MeanRotationTrajectory model(std::move(inner), mean, 0.0, 0.5);
+  *model.mutable_block(0) = 0.03;
+  const std::unique_ptr<TrajectoryModel> wider =
+      model.WithMoreModes(0.05, 4, &error);
+  ASSERT_NE(wider, nullptr) << error;
+  ASSERT_EQ(wider->num_blocks(), model.num_blocks());
+  EXPECT_EQ(*wider->block(0), 0.03);
+  EXPECT_GT(wider->block_size(1), model.block_size(1));
+  for (double t = 0.0; t <= 30.0; t += 2.5) {
+    EXPECT_LT((wider->Pose(t) - model.Pose(t)).norm(), 1e-12) << t;
+  }
+  EXPECT_EQ(MakeModel(0.5)->WithMoreModes(0.05, 4, &error), nullptr);
+  EXPECT_EQ(error, "the model has no basis to extend");
 }
 
 // Folding applies the exact rotation: poses change by the second-order
