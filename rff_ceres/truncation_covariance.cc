@@ -60,27 +60,35 @@ ColumnSplit SplitColumns(ceres::Problem* problem,
   return split;
 }
 
-// J's columns split into the kept and the new ones.
+// J's kept columns, and J_kept^T J_new (dense) row by row: a row's new
+// entries are those of the one or two segments it touches.
 void SplitJacobian(const Eigen::SparseMatrix<double, Eigen::RowMajor>& jacobian,
                    const ColumnSplit& split, ColumnMajorSparse* kept,
-                   ColumnMajorSparse* added) {
-  std::vector<Eigen::Triplet<double>> kept_entries, new_entries;
+                   Eigen::MatrixXd* cross) {
+  std::vector<Eigen::Triplet<double>> kept_entries;
+  cross->setZero(split.num_kept, split.num_new);
+  std::vector<std::pair<int, double>> row_kept, row_new;
   for (int row = 0; row < jacobian.outerSize(); ++row) {
+    row_kept.clear();
+    row_new.clear();
     for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(
              jacobian, row);
          it; ++it) {
       const int column = static_cast<int>(it.col());
       if (split.kept_of[column] >= 0) {
         kept_entries.emplace_back(row, split.kept_of[column], it.value());
+        row_kept.emplace_back(split.kept_of[column], it.value());
       } else if (split.new_of[column] >= 0) {
-        new_entries.emplace_back(row, split.new_of[column], it.value());
+        row_new.emplace_back(split.new_of[column], it.value());
       }
+    }
+    for (const auto& [j, c] : row_new) {
+      double* column = cross->col(j).data();
+      for (const auto& [i, a] : row_kept) column[i] += a * c;
     }
   }
   kept->resize(jacobian.rows(), split.num_kept);
   kept->setFromTriplets(kept_entries.begin(), kept_entries.end());
-  added->resize(jacobian.rows(), split.num_new);
-  added->setFromTriplets(new_entries.begin(), new_entries.end());
 }
 
 }  // namespace
@@ -165,23 +173,16 @@ void AddTruncationCovariance(
             " is not the solved " + FormatNumber(solved_cost);
     return;
   }
-  ColumnMajorSparse kept, added;
-  SplitJacobian(jacobian, split, &kept, &added);
+  // G = H^-1 J_theta^T J_c.
+  ColumnMajorSparse kept;
+  Eigen::MatrixXd response;
+  SplitJacobian(jacobian, split, &kept, &response);
   const Eigen::LLT<Eigen::MatrixXd> factor(
       Eigen::MatrixXd(kept.transpose() * kept));
   if (factor.info() != Eigen::Success ||
       !(factor.rcond() > kMinReciprocalCondition)) {
     *note = "none: J^T J is singular to rounding";
     return;
-  }
-  // G = H^-1 J_theta^T J_c, a panel of new modes at a time (J_c dense).
-  Eigen::MatrixXd response(split.num_kept, split.num_new);
-  const ColumnMajorSparse kept_transposed = kept.transpose();
-  constexpr int kPanel = 256;
-  for (int first = 0; first < split.num_new; first += kPanel) {
-    const int width = std::min(kPanel, split.num_new - first);
-    response.middleCols(first, width) =
-        kept_transposed * Eigen::MatrixXd(added.middleCols(first, width));
   }
   factor.solveInPlace(response);
 
