@@ -114,11 +114,11 @@ void AddTruncationCovariance(
   // A dense LLT of H, its solves for the new modes, and every pose's two
   // segments' features through them.
   const double n = problem->problem()->NumParameters();
-  const double m = static_cast<double>(ModelBlocks(*extended).size() -
-                                       ModelBlocks(model).size());
   const double rows = 3.0 * static_cast<double>(times.size());
+  double m = 0.0;
   int widest_block = 0;
   for (int b = 0; b < extended->num_blocks(); ++b) {
+    m += extended->block_size(b) - model.block_size(b);
     widest_block = std::max(widest_block, extended->block_size(b));
   }
   const double work =

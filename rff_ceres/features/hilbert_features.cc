@@ -47,8 +47,9 @@ int HilbertModesForTail(const Kernel& kernel, double half_width, int d,
     return 1.0 - kernel.FrequencyCdf(M_PI * (modes + 0.5) / (2.0 * half_width));
   };
   // Below rounding the basis misses nothing: one more mode says so.
-  if (!(tail(d) > 1e-12)) return std::min(d + 1, most);
-  const double target = fraction * tail(d);
+  const double missed = tail(d);
+  if (!(missed > 1e-12)) return std::min(d + 1, most);
+  const double target = fraction * missed;
   int modes = d + 1;
   while (modes < most && tail(modes) > target) ++modes;
   return std::min(modes, most);
