@@ -18,7 +18,7 @@
 namespace rff {
 
 template <int kNumResiduals, int kNumPoses, bool kHasLandmark>
-class PoseCost : public ceres::CostFunction {
+class PoseCost : public ceres::CostFunction, public PoseMapped {
  public:
   using PoseGradient = Eigen::Matrix<double, kNumResiduals, 3, Eigen::RowMajor>;
   using LandmarkGradient =
@@ -68,7 +68,8 @@ class PoseCost : public ceres::CostFunction {
     return true;
   }
 
-  const PoseMap& map(int k) const { return maps_[k]; }
+  int num_pose_maps() const final { return kNumPoses; }
+  const PoseMap& pose_map(int k) const final { return maps_[k]; }
 
  protected:
   // Fills the residual and, when the gradient pointers are non-null, its

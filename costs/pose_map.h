@@ -32,6 +32,16 @@ struct PoseMap {
   std::vector<PoseTerm> terms;
 };
 
+// A cost that sees poses only through PoseMaps (PoseCost): row r of the
+// Jacobian of term i's block is (dr/dpose)(r, c_i) phi_i^T, so the rows of
+// costs at one time span at most one row per term (banded_problem.cc).
+class PoseMapped {
+ public:
+  virtual ~PoseMapped() = default;
+  virtual int num_pose_maps() const = 0;
+  virtual const PoseMap& pose_map(int k) const = 0;
+};
+
 // pose = mean + sum of phi^T b over the terms.
 inline Eigen::Vector3d EvaluatePose(const PoseMap& map,
                                     double const* const* parameters) {

@@ -1,10 +1,13 @@
 #include "rff_ceres/banded_problem.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <unordered_map>
 #include <unordered_set>
 #include <utility>
+
+#include "Eigen/Cholesky"
 
 namespace rff {
 
@@ -157,6 +160,77 @@ BandedProblem::BandedProblem(const ceres::Problem& problem,
     (variable ? terms_ : fixed_terms_).push_back(term);
   }
   envelope_first_ = EnvelopeFirst();
+  MarkCompressedRuns();
+}
+
+namespace {
+
+// A term's pose map when its panel rows are rank one per map term: one
+// pose, each map term on its own panel block, covering them all.
+const PoseMap* CompressibleMap(const ceres::CostFunction* cost, int num_blocks,
+                               const int* column, const char* in_panel,
+                               int num_panel_blocks) {
+  const auto* mapped = dynamic_cast<const PoseMapped*>(cost);
+  if (mapped == nullptr || mapped->num_pose_maps() != 1) return nullptr;
+  const PoseMap& map = mapped->pose_map(0);
+  const int n = static_cast<int>(map.terms.size());
+  if (n != num_panel_blocks || n > kMaxCompressedTerms) return nullptr;
+  std::vector<int> columns;
+  for (const PoseTerm& t : map.terms) {
+    if (t.block >= num_blocks || !in_panel[t.block]) return nullptr;
+    columns.push_back(column[t.block]);
+  }
+  std::sort(columns.begin(), columns.end());
+  const bool distinct =
+      std::adjacent_find(columns.begin(), columns.end()) == columns.end();
+  return distinct ? &map : nullptr;
+}
+
+// Whether two terms' maps put the same feature vectors on the same columns.
+bool SameRows(const PoseMap& a, const int* a_column, const PoseMap& b,
+              const int* b_column) {
+  if (a.terms.size() != b.terms.size()) return false;
+  for (std::size_t i = 0; i < a.terms.size(); ++i) {
+    if (a.terms[i].phi != b.terms[i].phi ||
+        a_column[a.terms[i].block] != b_column[b.terms[i].block]) {
+      return false;
+    }
+  }
+  return true;
+}
+
+}  // namespace
+
+void BandedProblem::MarkCompressedRuns() {
+  std::vector<const PoseMap*> maps(terms_.size());
+  for (std::size_t k = 0; k < terms_.size(); ++k) {
+    const Term& t = terms_[k];
+    maps[k] = CompressibleMap(t.cost, t.num_blocks, t.column, t.in_panel,
+                              t.num_panel_blocks);
+  }
+  std::size_t begin = 0;
+  while (begin < terms_.size()) {
+    std::size_t end = begin + 1;
+    if (maps[begin] == nullptr) {
+      begin = end;
+      continue;
+    }
+    int rows = terms_[begin].cost->num_residuals();
+    while (end < terms_.size() && maps[end] != nullptr &&
+           SameRows(*maps[begin], terms_[begin].column, *maps[end],
+                    terms_[end].column)) {
+      rows += terms_[end++].cost->num_residuals();
+    }
+    // Fewer rows than terms would only grow the panel.
+    if (rows > static_cast<int>(maps[begin]->terms.size())) {
+      for (std::size_t k = begin; k < end; ++k) {
+        terms_[k].compressed_map = maps[k];
+      }
+      terms_[end - 1].closes_run = true;
+      ++compressed_runs_;
+    }
+    begin = end;
+  }
 }
 
 int BandedProblem::ColumnOf(const double* block) const {
@@ -236,6 +310,7 @@ bool BandedProblem::Linearize(const Eigen::VectorXd& x, double* cost,
   panel_rows_ = 0;
   panel_columns_.clear();
   panel_sizes_.clear();
+  run_open_ = false;
   for (const Term& term : terms_) {
     double term_cost;
     if (!Evaluate(term, x, /*jacobians=*/true, &term_cost)) return false;
@@ -336,35 +411,17 @@ void BandedProblem::Accumulate(const Term& term, Eigen::VectorXd* g,
                                EnvelopeMatrix* h) {
   const int rows = static_cast<int>(residual_buffer_.size());
   const double* residual = residual_buffer_.data();
-  if (term.num_panel_blocks > 0) {
-    // The term's rows join the panel if it is on the same blocks.
-    bool same =
-        panel_rows_ < kMaxPanelRows &&
-        static_cast<int>(panel_columns_.size()) == term.num_panel_blocks;
-    for (int a = 0, p = 0; same && a < term.num_blocks; ++a) {
-      if (term.in_panel[a]) same = panel_columns_[p++] == term.column[a];
-    }
-    if (!same) {
-      FlushPanel(h);
-      for (int a = 0; a < term.num_blocks; ++a) {
-        if (!term.in_panel[a]) continue;
-        panel_columns_.push_back(term.column[a]);
-        panel_sizes_.push_back(term.size[a]);
-      }
-    }
-    int width = 0;
-    for (const int s : panel_sizes_) width += s;
-    panel_.resize(static_cast<std::size_t>(panel_rows_ + rows) * width);
+  if (term.compressed_map != nullptr) {
+    AccumulateRun(term, h);
+  } else if (term.num_panel_blocks > 0) {
+    double* out = PanelRows(term, rows, h);
     for (int k = 0; k < rows; ++k) {
-      double* out =
-          panel_.data() + static_cast<std::size_t>(panel_rows_ + k) * width;
       for (int a = 0; a < term.num_blocks; ++a) {
         if (!term.in_panel[a]) continue;
         const double* j = jacobian_rows_[a].data() + k * term.size[a];
         out = std::copy(j, j + term.size[a], out);
       }
     }
-    panel_rows_ += rows;
   }
   for (int a = 0; a < term.num_blocks; ++a) {
     if (term.column[a] < 0) continue;
@@ -384,6 +441,82 @@ void BandedProblem::Accumulate(const Term& term, Eigen::VectorXd* g,
         AddColumnProducts(a == b ? i + 1 : sb, rows, ja + i, sa, jb, sb,
                           &(*h)(ca + i, cb));
       }
+    }
+  }
+}
+
+double* BandedProblem::PanelRows(const Term& term, int rows,
+                                 EnvelopeMatrix* h) {
+  // The term's rows join the panel if it is on the same blocks.
+  bool same = panel_rows_ < kMaxPanelRows &&
+              static_cast<int>(panel_columns_.size()) == term.num_panel_blocks;
+  for (int a = 0, p = 0; same && a < term.num_blocks; ++a) {
+    if (term.in_panel[a]) same = panel_columns_[p++] == term.column[a];
+  }
+  if (!same) {
+    FlushPanel(h);
+    for (int a = 0; a < term.num_blocks; ++a) {
+      if (!term.in_panel[a]) continue;
+      panel_columns_.push_back(term.column[a]);
+      panel_sizes_.push_back(term.size[a]);
+    }
+  }
+  int width = 0;
+  for (const int s : panel_sizes_) width += s;
+  panel_.resize(static_cast<std::size_t>(panel_rows_ + rows) * width);
+  double* out = panel_.data() + static_cast<std::size_t>(panel_rows_) * width;
+  panel_rows_ += rows;
+  return out;
+}
+
+void BandedProblem::AccumulateRun(const Term& term, EnvelopeMatrix* h) {
+  const PoseMap& map = *term.compressed_map;
+  const int n = static_cast<int>(map.terms.size());
+  if (!run_open_) {
+    run_gram_.setZero(n, n);
+    run_inverse_norms_.resize(n);
+    for (int i = 0; i < n; ++i) {
+      const double norm = map.terms[i].phi->squaredNorm();
+      run_inverse_norms_[i] = norm > 0.0 ? 1.0 / norm : 0.0;
+    }
+    run_open_ = true;
+  }
+  // Row k on term i's block is G(k, i) phi_i (pose_map.h).
+  Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxCompressedTerms, 1> g(n);
+  const int rows = static_cast<int>(residual_buffer_.size());
+  for (int k = 0; k < rows; ++k) {
+    for (int i = 0; i < n; ++i) {
+      const PoseTerm& t = map.terms[i];
+      const Eigen::Map<const Eigen::VectorXd> row(
+          jacobian_rows_[t.block].data() + k * term.size[t.block],
+          term.size[t.block]);
+      g[i] = row.dot(*t.phi) * run_inverse_norms_[i];
+    }
+    run_gram_.selfadjointView<Eigen::Lower>().rankUpdate(g);
+  }
+  if (!term.closes_run) return;
+  run_open_ = false;
+  // G^T G = P^T L D L^T P, so M = D^(1/2) L^T P: at most n rows.
+  const Eigen::LDLT<SmallMatrix, Eigen::Lower> ldlt(run_gram_);
+  const SmallMatrix pl =
+      ldlt.transpositionsP().transpose() * SmallMatrix(ldlt.matrixL());
+  std::array<int, kMaxCompressedTerms> offset{};
+  for (int a = 0, o = 0; a < term.num_blocks; ++a) {
+    if (!term.in_panel[a]) continue;
+    for (int i = 0; i < n; ++i) {
+      if (map.terms[i].block == a) offset[i] = o;
+    }
+    o += term.size[a];
+  }
+  for (int r = 0; r < n; ++r) {
+    const double d = ldlt.vectorD()[r];
+    if (!(d > 0.0)) continue;
+    const double scale = std::sqrt(d);
+    double* out = PanelRows(term, 1, h);
+    std::fill(out, out + panel_.size() - (out - panel_.data()), 0.0);
+    for (int i = 0; i < n; ++i) {
+      Eigen::Map<Eigen::VectorXd>(out + offset[i], map.terms[i].phi->size()) =
+          (scale * pl(i, r)) * *map.terms[i].phi;
     }
   }
 }

@@ -15,6 +15,7 @@
 #include "ceres/cost_function.h"
 #include "ceres/loss_function.h"
 #include "ceres/problem.h"
+#include "costs/pose_map.h"
 #include "rff_ceres/envelope_cholesky.h"
 
 namespace rff {
@@ -42,6 +43,9 @@ std::vector<double*> BandedBlockOrder(const ceres::Problem& problem,
 inline constexpr int kMinPanelWidth = 12;
 // Rows a panel holds before it is multiplied out.
 inline constexpr int kMaxPanelRows = 256;
+// Most terms of a pose map whose costs' panel rows are compressed (x, y
+// and theta of two blended windows).
+inline constexpr int kMaxCompressedTerms = 6;
 
 // The envelope of H in a column order: its columns (the variables), the
 // doubles it stores and the multiply-adds of one factorisation.
@@ -69,6 +73,8 @@ class BandedProblem {
   // Whether some residual has wide timed blocks (kMinPanelWidth): their
   // products are formed a panel at a time.
   bool has_panels() const { return has_panels_; }
+  // The runs of costs at one time whose panel rows are compressed (Term).
+  int compressed_runs() const { return compressed_runs_; }
   int num_variable_blocks() const {
     return static_cast<int>(variables_.size());
   }
@@ -122,9 +128,23 @@ class BandedProblem {
     // the term's other such blocks go through the panel.
     const char* in_panel = nullptr;
     int num_panel_blocks = 0;
+    // Set on each of a run of PoseMapped costs of one pose map (the costs
+    // at one time) whose rows outnumber the map's terms: their panel rows
+    // G Phi join the panel as the rows of M Phi, M^T M = G^T G, the last
+    // of the run (`closes_run`) adding them.
+    const PoseMap* compressed_map = nullptr;
+    bool closes_run = false;
   };
 
   std::vector<int> EnvelopeFirst() const;
+  // Marks the runs of terms whose panel rows are compressed (Term).
+  void MarkCompressedRuns();
+  // The rows of `rows` more rows in the panel, after flushing it when full
+  // or on other blocks than the term's panel blocks.
+  double* PanelRows(const Term& term, int rows, EnvelopeMatrix* h);
+  // Adds the last Evaluate's rows to the run's G^T G, and at its end the
+  // rows of M Phi to the panel.
+  void AccumulateRun(const Term& term, EnvelopeMatrix* h);
   // One term's cost at x and, with `jacobians`, its corrected residual and
   // Jacobian blocks in the buffers below.
   bool Evaluate(const Term& term, const Eigen::VectorXd& x, bool jacobians,
@@ -148,6 +168,7 @@ class BandedProblem {
   int num_columns_ = 0;
   int num_rows_ = 0;
   bool has_panels_ = false;
+  int compressed_runs_ = 0;
   std::vector<int> envelope_first_;
   std::vector<const double*> parameters_;
   std::vector<std::vector<double>> jacobian_rows_;
@@ -158,6 +179,13 @@ class BandedProblem {
   std::vector<int> panel_columns_, panel_sizes_;
   std::vector<double> panel_;
   int panel_rows_ = 0;
+  // The open run: G^T G of its pose-space rows, 1 / |phi|^2 of its terms.
+  using SmallMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0,
+                                    kMaxCompressedTerms, kMaxCompressedTerms>;
+  SmallMatrix run_gram_;
+  Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxCompressedTerms, 1>
+      run_inverse_norms_;
+  bool run_open_ = false;
 };
 
 // A layout with g = J^T r and H = J^T J accumulated at x (Linearize), as

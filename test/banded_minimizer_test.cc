@@ -7,6 +7,8 @@
 
 #include "ceres/autodiff_cost_function.h"
 #include "ceres/ceres.h"
+#include "costs/pose_map.h"
+#include "costs/range_bearing_cost.h"
 #include "gtest/gtest.h"
 #include "rff_ceres/banded_problem.h"
 #include "rff_ceres/envelope_cholesky.h"
@@ -478,29 +480,20 @@ struct WindowProblem {
   }
 };
 
-// The panel's products (wide windows' rows multiplied out together) give
-// Ceres's own J^T J and J^T r, through the losses' corrections; 150
-// observations a window fill the panel past kMaxPanelRows.
-TEST(BandedMinimizerTest, PanelProductsAreThoseOfTheJacobian) {
-  static_assert(kMinPanelWidth <= 12 && kMaxPanelRows < 2 * 150 + 12);
-  WindowProblem windows(12, 150);
-  BandedProblem banded(*windows.problem, windows.Columns());
-  ASSERT_EQ(banded.num_columns(), 12 * 12 + 2 * 7);
-  const Eigen::VectorXd x = banded.Gather();
-  EnvelopeMatrix h(banded.envelope_first());
-  Eigen::VectorXd g;
-  double cost;
-  ASSERT_TRUE(banded.Linearize(x, &cost, &g, &h));
-
-  // Ceres's Jacobian in the banded column order.
+// H, g and the cost of `banded` at its variables' values are those of
+// Ceres's own Jacobian of `problem`, in the banded column order.
+void ExpectCeresLinearization(ceres::Problem& problem,
+                              const BandedColumns& columns,
+                              const BandedProblem& banded, double cost,
+                              const Eigen::VectorXd& g,
+                              const EnvelopeMatrix& h) {
   ceres::Problem::EvaluateOptions options;
-  options.parameter_blocks =
-      BandedBlockOrder(*windows.problem, windows.Columns());
+  options.parameter_blocks = BandedBlockOrder(problem, columns);
   double expected_cost;
   std::vector<double> residuals;
   ceres::CRSMatrix crs;
-  ASSERT_TRUE(windows.problem->Evaluate(options, &expected_cost, &residuals,
-                                        nullptr, &crs));
+  ASSERT_TRUE(
+      problem.Evaluate(options, &expected_cost, &residuals, nullptr, &crs));
   Eigen::MatrixXd jacobian = Eigen::MatrixXd::Zero(crs.num_rows, crs.num_cols);
   for (int r = 0; r < crs.num_rows; ++r) {
     for (int k = crs.rows[r]; k < crs.rows[r + 1]; ++k) {
@@ -515,11 +508,112 @@ TEST(BandedMinimizerTest, PanelProductsAreThoseOfTheJacobian) {
   const double scale = expected_h.cwiseAbs().maxCoeff();
   for (int i = 0; i < banded.num_columns(); ++i) {
     EXPECT_NEAR(g[i], expected_g[i], 1e-12 * scale) << i;
-    for (int j = 0; j < banded.num_columns(); ++j) {
-      const double stored = j >= h.first(i) && j <= i ? h(i, j) : 0.0;
-      if (j <= i) EXPECT_NEAR(stored, expected_h(i, j), 1e-12 * scale) << i;
+    for (int j = 0; j <= i; ++j) {
+      const double stored = j >= h.first(i) ? h(i, j) : 0.0;
+      EXPECT_NEAR(stored, expected_h(i, j), 1e-12 * scale) << i << ", " << j;
     }
   }
+}
+
+// The panel's products (wide windows' rows multiplied out together) give
+// Ceres's own J^T J and J^T r, through the losses' corrections; 150
+// observations a window fill the panel past kMaxPanelRows.
+TEST(BandedMinimizerTest, PanelProductsAreThoseOfTheJacobian) {
+  static_assert(kMinPanelWidth <= 12 && kMaxPanelRows < 2 * 150 + 12);
+  WindowProblem windows(12, 150);
+  BandedProblem banded(*windows.problem, windows.Columns());
+  ASSERT_EQ(banded.num_columns(), 12 * 12 + 2 * 7);
+  const Eigen::VectorXd x = banded.Gather();
+  EnvelopeMatrix h(banded.envelope_first());
+  Eigen::VectorXd g;
+  double cost;
+  ASSERT_TRUE(banded.Linearize(x, &cost, &g, &h));
+
+  ExpectCeresLinearization(*windows.problem, windows.Columns(), banded, cost, g,
+                           h);
+}
+
+// Windows of x, y and theta weights (12 each) seen through pose maps, as
+// feature trajectories are: at each of 5 times a window, one range-bearing
+// or three of different landmarks (every second under a Cauchy loss), and
+// four at the last time, blended with the next window's features.
+struct PoseWindowProblem {
+  static constexpr int kD = 12;
+  std::vector<std::vector<double>> weights;  // x, y, theta of each window.
+  std::vector<Eigen::Vector2d> landmarks;
+  std::unique_ptr<ceres::Problem> problem;
+  ceres::CauchyLoss loss{1.0};
+
+  explicit PoseWindowProblem(int n) : weights(3 * n), landmarks(4) {
+    ceres::Problem::Options options;
+    options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+    problem = std::make_unique<ceres::Problem>(options);
+    for (std::size_t b = 0; b < weights.size(); ++b) {
+      for (int i = 0; i < kD; ++i) weights[b].push_back(0.05 * std::sin(b + i));
+    }
+    for (std::size_t j = 0; j < landmarks.size(); ++j) {
+      landmarks[j] = 4.0 * Eigen::Vector2d(std::cos(j), std::sin(j));
+    }
+    int count = 0;
+    for (int k = 0; k < n; ++k) {
+      for (int t = 0; t < 5; ++t) {
+        PoseMap map;
+        map.mean = Eigen::Vector3d(0.1 * k, 0.2, 0.3);
+        const bool blended = t == 4 && k + 1 < n;
+        for (int w = k; w <= (blended ? k + 1 : k); ++w) {
+          auto position = std::make_shared<Eigen::VectorXd>(kD);
+          auto heading = std::make_shared<Eigen::VectorXd>(kD);
+          for (int i = 0; i < kD; ++i) {
+            (*position)[i] = std::cos(0.3 * (5 * k + t) + i + w);
+            (*heading)[i] = std::sin(0.2 * (5 * k + t) - i + w);
+          }
+          const int first = 3 * (w - k);
+          map.terms.push_back({first, 0, position});
+          map.terms.push_back({first + 1, 1, position});
+          map.terms.push_back({first + 2, 2, heading});
+        }
+        std::vector<double*> blocks;
+        for (int w = k; w <= (blended ? k + 1 : k); ++w) {
+          for (int c = 0; c < 3; ++c)
+            blocks.push_back(weights[3 * w + c].data());
+        }
+        const int costs = t % 3 == 0 ? 1 : (t == 4 ? 4 : 3);
+        for (int o = 0; o < costs; ++o, ++count) {
+          blocks.push_back(landmarks[(k + o) % landmarks.size()].data());
+          problem->AddResidualBlock(
+              new RangeBearingCost(map, 3.0 + 0.1 * std::sin(count),
+                                   0.2 * std::cos(count), 0.1, 0.05),
+              count % 2 == 0 ? &loss : nullptr, blocks);
+          blocks.pop_back();
+        }
+      }
+    }
+  }
+
+  BandedColumns Columns() {
+    BandedColumns columns;
+    for (std::vector<double>& w : weights) columns.timed.push_back(w.data());
+    for (Eigen::Vector2d& l : landmarks) columns.placed.push_back(l.data());
+    return columns;
+  }
+};
+
+// Costs at one time whose rows outnumber their pose map's terms enter the
+// panel as at most one row per term; H and g stay Ceres's.
+TEST(BandedMinimizerTest, CompressedPoseRunsGiveTheProductsOfTheJacobian) {
+  static_assert(kMinPanelWidth <= PoseWindowProblem::kD);
+  PoseWindowProblem windows(6);
+  BandedProblem banded(*windows.problem, windows.Columns());
+  // The times with three or four costs (6 rows over 3 terms, 8 over 6 where
+  // blended) each make a run; those with one (2 rows over 3) are left.
+  EXPECT_EQ(banded.compressed_runs(), 6 * 3);
+  const Eigen::VectorXd x = banded.Gather();
+  EnvelopeMatrix h(banded.envelope_first());
+  Eigen::VectorXd g;
+  double cost;
+  ASSERT_TRUE(banded.Linearize(x, &cost, &g, &h));
+  ExpectCeresLinearization(*windows.problem, windows.Columns(), banded, cost, g,
+                           h);
 }
 
 // A linearisation that fails part way (a weight of the last window not
