@@ -37,21 +37,12 @@ class PoseCost : public ceres::CostFunction, public PoseMapped {
 
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const final {
-    std::array<Eigen::Vector3d, kNumPoses> poses;
-    for (int k = 0; k < kNumPoses; ++k) {
-      poses[k] = EvaluatePose(maps_[k], parameters);
-    }
-    const Eigen::Vector2d landmark =
-        kHasLandmark ? Eigen::Vector2d(parameters[num_pose_blocks_][0],
-                                       parameters[num_pose_blocks_][1])
-                     : Eigen::Vector2d::Zero();
-    Eigen::Map<Residuals> r(residuals);
     if (jacobians == nullptr) {
-      return Residual(poses, landmark, &r, nullptr, nullptr);
+      return ResidualAt(parameters, residuals, nullptr, nullptr);
     }
     std::array<PoseGradient, kNumPoses> dr_dposes;
     LandmarkGradient dr_dlandmark;
-    if (!Residual(poses, landmark, &r, &dr_dposes, &dr_dlandmark)) {
+    if (!ResidualAt(parameters, residuals, &dr_dposes, &dr_dlandmark)) {
       return false;
     }
     for (const PoseMap& map : maps_) {
@@ -68,6 +59,29 @@ class PoseCost : public ceres::CostFunction, public PoseMapped {
     return true;
   }
 
+  bool EvaluateAtPoses(double const* const* parameters, double* residuals,
+                       double* dr_dposes, double* dr_dlandmark) const final {
+    if (dr_dposes == nullptr) {
+      return ResidualAt(parameters, residuals, nullptr, nullptr);
+    }
+    std::array<PoseGradient, kNumPoses> pose_gradients;
+    LandmarkGradient landmark_gradient;
+    if (!ResidualAt(parameters, residuals, &pose_gradients,
+                    &landmark_gradient)) {
+      return false;
+    }
+    for (int k = 0; k < kNumPoses; ++k) {
+      Eigen::Map<PoseGradient> out(dr_dposes + 3 * kNumResiduals * k);
+      out = pose_gradients[k];
+    }
+    if (kHasLandmark && dr_dlandmark != nullptr) {
+      Eigen::Map<LandmarkGradient> out(dr_dlandmark);
+      out = landmark_gradient;
+    }
+    return true;
+  }
+
+  bool has_landmark() const final { return kHasLandmark; }
   int num_pose_maps() const final { return kNumPoses; }
   const PoseMap& pose_map(int k) const final { return maps_[k]; }
 
@@ -82,6 +96,22 @@ class PoseCost : public ceres::CostFunction, public PoseMapped {
                         LandmarkGradient* dr_dlandmark) const = 0;
 
  private:
+  // The poses and landmark at the parameters, then Residual.
+  bool ResidualAt(double const* const* parameters, double* residuals,
+                  std::array<PoseGradient, kNumPoses>* dr_dposes,
+                  LandmarkGradient* dr_dlandmark) const {
+    std::array<Eigen::Vector3d, kNumPoses> poses;
+    for (int k = 0; k < kNumPoses; ++k) {
+      poses[k] = EvaluatePose(maps_[k], parameters);
+    }
+    const Eigen::Vector2d landmark =
+        kHasLandmark ? Eigen::Vector2d(parameters[num_pose_blocks_][0],
+                                       parameters[num_pose_blocks_][1])
+                     : Eigen::Vector2d::Zero();
+    Eigen::Map<Residuals> r(residuals);
+    return Residual(poses, landmark, &r, dr_dposes, dr_dlandmark);
+  }
+
   std::array<PoseMap, kNumPoses> maps_;
   int num_pose_blocks_ = 0;
 };

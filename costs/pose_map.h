@@ -40,6 +40,15 @@ class PoseMapped {
   virtual ~PoseMapped() = default;
   virtual int num_pose_maps() const = 0;
   virtual const PoseMap& pose_map(int k) const = 0;
+  // Whether a 2-D landmark block follows the pose maps' blocks.
+  virtual bool has_landmark() const = 0;
+  // The residuals and, unless `dr_dposes` is null, their gradients with
+  // respect to pose k (row-major num_residuals x 3 at dr_dposes + 3
+  // num_residuals k) and to the landmark (num_residuals x 2, where the cost
+  // has one): the Jacobians without their feature vectors.
+  virtual bool EvaluateAtPoses(double const* const* parameters,
+                               double* residuals, double* dr_dposes,
+                               double* dr_dlandmark) const = 0;
 };
 
 // pose = mean + sum of phi^T b over the terms.

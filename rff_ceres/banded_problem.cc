@@ -92,6 +92,43 @@ void AddColumnProducts(int width, int rows, const double* a, int a_stride,
   }
 }
 
+// A robust loss's correction of one term's residual and Jacobian rows
+// (Triggs et al. 2000, 4.3, clamped as Ceres's Corrector clamps it where
+// rho'' <= 0), at the residual's squared norm.
+struct LossCorrection {
+  double cost = 0.0;
+  double sqrt_rho1 = 1.0, residual_scaling = 1.0, alpha_over_norm = 0.0;
+
+  LossCorrection(const ceres::LossFunction* loss, double squared_norm) {
+    double rho[3] = {squared_norm, 1.0, 0.0};
+    if (loss != nullptr) loss->Evaluate(squared_norm, rho);
+    cost = 0.5 * rho[0];
+    sqrt_rho1 = residual_scaling = std::sqrt(rho[1]);
+    if (squared_norm > 0.0 && rho[2] > 0.0) {
+      const double alpha =
+          1.0 - std::sqrt(1.0 + 2.0 * squared_norm * rho[2] / rho[1]);
+      residual_scaling = sqrt_rho1 / (1.0 - alpha);
+      alpha_over_norm = alpha / squared_norm;
+    }
+  }
+
+  // Corrects the row-major rows (residual.size() x cols) of a Jacobian
+  // block against the uncorrected residual; false where one is not finite.
+  bool CorrectRows(const Eigen::Map<Eigen::VectorXd>& residual, double* data,
+                   int cols) const {
+    Eigen::Map<
+        Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>
+        j(data, residual.size(), cols);
+    if (!j.allFinite()) return false;
+    if (alpha_over_norm != 0.0) {
+      const Eigen::RowVectorXd rj = residual.transpose() * j;
+      j -= alpha_over_norm * residual * rj;
+    }
+    j *= sqrt_rho1;
+    return true;
+  }
+};
+
 }  // namespace
 
 BandedProblem::BandedProblem(const ceres::Problem& problem,
@@ -165,25 +202,33 @@ BandedProblem::BandedProblem(const ceres::Problem& problem,
 
 namespace {
 
-// A term's pose map when its panel rows are rank one per map term: one
-// pose, each map term on its own panel block, covering them all.
-const PoseMap* CompressibleMap(const ceres::CostFunction* cost, int num_blocks,
-                               const int* column, const char* in_panel,
-                               int num_panel_blocks) {
+// A term's cost when its rows on the weights are rank one per pose-map
+// term: one pose, its map's terms each on its own panel block, which are
+// the term's blocks 0..n-1, then at most the landmark, placed after them.
+const PoseMapped* CompressibleCost(const ceres::CostFunction* cost,
+                                   int num_blocks, const int* column,
+                                   const char* in_panel) {
   const auto* mapped = dynamic_cast<const PoseMapped*>(cost);
   if (mapped == nullptr || mapped->num_pose_maps() != 1) return nullptr;
   const PoseMap& map = mapped->pose_map(0);
   const int n = static_cast<int>(map.terms.size());
-  if (n != num_panel_blocks || n > kMaxCompressedTerms) return nullptr;
-  std::vector<int> columns;
-  for (const PoseTerm& t : map.terms) {
-    if (t.block >= num_blocks || !in_panel[t.block]) return nullptr;
-    columns.push_back(column[t.block]);
+  if (n > kMaxCompressedTerms ||
+      num_blocks != n + (mapped->has_landmark() ? 1 : 0)) {
+    return nullptr;
   }
-  std::sort(columns.begin(), columns.end());
+  std::vector<int> blocks;
+  for (const PoseTerm& t : map.terms) {
+    if (t.block >= n || !in_panel[t.block]) return nullptr;
+    // A landmark's row of H is then after the weights' (AccumulateRun).
+    if (num_blocks > n && column[n] >= 0 && column[n] < column[t.block]) {
+      return nullptr;
+    }
+    blocks.push_back(t.block);
+  }
+  std::sort(blocks.begin(), blocks.end());
   const bool distinct =
-      std::adjacent_find(columns.begin(), columns.end()) == columns.end();
-  return distinct ? &map : nullptr;
+      std::adjacent_find(blocks.begin(), blocks.end()) == blocks.end();
+  return distinct ? mapped : nullptr;
 }
 
 // Whether two terms' maps put the same feature vectors on the same columns.
@@ -202,29 +247,29 @@ bool SameRows(const PoseMap& a, const int* a_column, const PoseMap& b,
 }  // namespace
 
 void BandedProblem::MarkCompressedRuns() {
-  std::vector<const PoseMap*> maps(terms_.size());
+  std::vector<const PoseMapped*> costs(terms_.size());
   for (std::size_t k = 0; k < terms_.size(); ++k) {
     const Term& t = terms_[k];
-    maps[k] = CompressibleMap(t.cost, t.num_blocks, t.column, t.in_panel,
-                              t.num_panel_blocks);
+    costs[k] = CompressibleCost(t.cost, t.num_blocks, t.column, t.in_panel);
   }
   std::size_t begin = 0;
   while (begin < terms_.size()) {
     std::size_t end = begin + 1;
-    if (maps[begin] == nullptr) {
+    if (costs[begin] == nullptr) {
       begin = end;
       continue;
     }
+    const PoseMap& map = costs[begin]->pose_map(0);
     int rows = terms_[begin].cost->num_residuals();
-    while (end < terms_.size() && maps[end] != nullptr &&
-           SameRows(*maps[begin], terms_[begin].column, *maps[end],
+    while (end < terms_.size() && costs[end] != nullptr &&
+           SameRows(map, terms_[begin].column, costs[end]->pose_map(0),
                     terms_[end].column)) {
       rows += terms_[end++].cost->num_residuals();
     }
     // Fewer rows than terms would only grow the panel.
-    if (rows > static_cast<int>(maps[begin]->terms.size())) {
+    if (rows > static_cast<int>(map.terms.size())) {
       for (std::size_t k = begin; k < end; ++k) {
-        terms_[k].compressed_map = maps[k];
+        terms_[k].compressed = costs[k];
       }
       terms_[end - 1].closes_run = true;
       ++compressed_runs_;
@@ -313,9 +358,14 @@ bool BandedProblem::Linearize(const Eigen::VectorXd& x, double* cost,
   run_open_ = false;
   for (const Term& term : terms_) {
     double term_cost;
-    if (!Evaluate(term, x, /*jacobians=*/true, &term_cost)) return false;
+    if (term.compressed != nullptr) {
+      if (!EvaluateOnPose(term, x, &term_cost)) return false;
+      AccumulateRun(term, g, h);
+    } else {
+      if (!Evaluate(term, x, /*jacobians=*/true, &term_cost)) return false;
+      Accumulate(term, g, h);
+    }
     *cost += term_cost;
-    Accumulate(term, g, h);
   }
   FlushPanel(h);
   return true;
@@ -378,32 +428,55 @@ bool BandedProblem::Evaluate(const Term& term, const Eigen::VectorXd& x,
       !residual.allFinite()) {
     return false;
   }
-  const double squared_norm = residual.squaredNorm();
-  double rho[3] = {squared_norm, 1.0, 0.0};
-  if (term.loss != nullptr) term.loss->Evaluate(squared_norm, rho);
-  *cost = 0.5 * rho[0];
+  const LossCorrection correction(term.loss, residual.squaredNorm());
+  *cost = correction.cost;
   if (!jacobians) return std::isfinite(*cost);
-  const double sqrt_rho1 = std::sqrt(rho[1]);
-  double residual_scaling = sqrt_rho1, alpha_over_norm = 0.0;
-  if (squared_norm > 0.0 && rho[2] > 0.0) {
-    const double alpha =
-        1.0 - std::sqrt(1.0 + 2.0 * squared_norm * rho[2] / rho[1]);
-    residual_scaling = sqrt_rho1 / (1.0 - alpha);
-    alpha_over_norm = alpha / squared_norm;
-  }
   for (std::size_t a = 0; a < n; ++a) {
-    if (jacobian_pointers_[a] == nullptr) continue;
-    Eigen::Map<
-        Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>
-        j(jacobian_rows_[a].data(), rows, term.size[a]);
-    if (!j.allFinite()) return false;
-    if (alpha_over_norm != 0.0) {
-      const Eigen::RowVectorXd rj = residual.transpose() * j;
-      j -= alpha_over_norm * residual * rj;
+    if (jacobian_pointers_[a] != nullptr &&
+        !correction.CorrectRows(residual, jacobian_rows_[a].data(),
+                                term.size[a])) {
+      return false;
     }
-    j *= sqrt_rho1;
   }
-  residual *= residual_scaling;
+  residual *= correction.residual_scaling;
+  return std::isfinite(*cost);
+}
+
+bool BandedProblem::EvaluateOnPose(const Term& term, const Eigen::VectorXd& x,
+                                   double* cost) {
+  const int rows = term.cost->num_residuals();
+  parameters_.resize(term.num_blocks);
+  for (int a = 0; a < term.num_blocks; ++a) {
+    parameters_[a] =
+        term.column[a] >= 0 ? x.data() + term.column[a] : term.blocks[a];
+  }
+  residual_buffer_.resize(rows);
+  pose_rows_.resize(3 * rows);
+  landmark_rows_.resize(2 * rows);
+  Eigen::Map<Eigen::VectorXd> residual(residual_buffer_.data(), rows);
+  if (!term.compressed->EvaluateAtPoses(parameters_.data(), residual.data(),
+                                        pose_rows_.data(),
+                                        landmark_rows_.data()) ||
+      !residual.allFinite()) {
+    return false;
+  }
+  const LossCorrection correction(term.loss, residual.squaredNorm());
+  *cost = correction.cost;
+  // Row r on term i's block is (dr/dpose)(r, c_i) phi_i^T (pose_map.h).
+  const PoseMap& map = term.compressed->pose_map(0);
+  const int n = static_cast<int>(map.terms.size());
+  term_rows_.resize(static_cast<std::size_t>(rows) * n);
+  for (int r = 0; r < rows; ++r) {
+    for (int i = 0; i < n; ++i) {
+      term_rows_[r * n + i] = pose_rows_[3 * r + map.terms[i].coordinate];
+    }
+  }
+  if (!correction.CorrectRows(residual, term_rows_.data(), n) ||
+      (term.compressed->has_landmark() &&
+       !correction.CorrectRows(residual, landmark_rows_.data(), 2))) {
+    return false;
+  }
+  residual *= correction.residual_scaling;
   return std::isfinite(*cost);
 }
 
@@ -411,9 +484,7 @@ void BandedProblem::Accumulate(const Term& term, Eigen::VectorXd* g,
                                EnvelopeMatrix* h) {
   const int rows = static_cast<int>(residual_buffer_.size());
   const double* residual = residual_buffer_.data();
-  if (term.compressed_map != nullptr) {
-    AccumulateRun(term, h);
-  } else if (term.num_panel_blocks > 0) {
+  if (term.num_panel_blocks > 0) {
     double* out = PanelRows(term, rows, h);
     for (int k = 0; k < rows; ++k) {
       for (int a = 0; a < term.num_blocks; ++a) {
@@ -469,54 +540,71 @@ double* BandedProblem::PanelRows(const Term& term, int rows,
   return out;
 }
 
-void BandedProblem::AccumulateRun(const Term& term, EnvelopeMatrix* h) {
-  const PoseMap& map = *term.compressed_map;
+void BandedProblem::AccumulateRun(const Term& term, Eigen::VectorXd* g,
+                                  EnvelopeMatrix* h) {
+  const PoseMap& map = term.compressed->pose_map(0);
   const int n = static_cast<int>(map.terms.size());
-  if (!run_open_) {
-    run_gram_.setZero(n, n);
-    run_inverse_norms_.resize(n);
-    for (int i = 0; i < n; ++i) {
-      const double norm = map.terms[i].phi->squaredNorm();
-      run_inverse_norms_[i] = norm > 0.0 ? 1.0 / norm : 0.0;
-    }
-    run_open_ = true;
-  }
-  // Row k on term i's block is G(k, i) phi_i (pose_map.h).
-  Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxCompressedTerms, 1> g(n);
   const int rows = static_cast<int>(residual_buffer_.size());
-  for (int k = 0; k < rows; ++k) {
+  using RowMajor =
+      Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  const Eigen::Map<const RowMajor> on_terms(term_rows_.data(), rows, n);
+  const Eigen::Map<const Eigen::VectorXd> residual(residual_buffer_.data(),
+                                                   rows);
+  // The weights' gradient: term i's block gains (G^T r)_i phi_i.
+  const Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxCompressedTerms, 1>
+      term_gradient = on_terms.transpose() * residual;
+  for (int i = 0; i < n; ++i) {
+    const PoseTerm& t = map.terms[i];
+    g->segment(term.column[t.block], t.phi->size()) +=
+        term_gradient[i] * *t.phi;
+  }
+  const int l = term.compressed->has_landmark() ? term.column[n] : -1;
+  if (l >= 0) {
+    const Eigen::Map<const RowMajor> on_landmark(landmark_rows_.data(), rows,
+                                                 2);
+    g->segment(l, 2) += on_landmark.transpose() * residual;
+    const Eigen::Matrix2d ll = on_landmark.transpose() * on_landmark;
+    (*h)(l, l) += ll(0, 0);
+    (*h)(l + 1, l) += ll(1, 0);
+    (*h)(l + 1, l + 1) += ll(1, 1);
+    // The landmark's products with term i's block: C(j, i) phi_i.
+    const Eigen::Matrix<double, 2, Eigen::Dynamic, Eigen::RowMajor, 2,
+                        kMaxCompressedTerms>
+        c = on_landmark.transpose() * on_terms;
     for (int i = 0; i < n; ++i) {
       const PoseTerm& t = map.terms[i];
-      const Eigen::Map<const Eigen::VectorXd> row(
-          jacobian_rows_[t.block].data() + k * term.size[t.block],
-          term.size[t.block]);
-      g[i] = row.dot(*t.phi) * run_inverse_norms_[i];
+      const int b = term.column[t.block];
+      const int size = static_cast<int>(t.phi->size());
+      for (int j = 0; j < 2; ++j) {  // Row l + j of H: l > b.
+        Eigen::Map<Eigen::RowVectorXd>(&(*h)(l + j, b), size) +=
+            c(j, i) * t.phi->transpose();
+      }
     }
-    run_gram_.selfadjointView<Eigen::Lower>().rankUpdate(g);
   }
+  if (!run_open_) {
+    run_gram_.setZero(n, n);
+    run_open_ = true;
+  }
+  run_gram_.selfadjointView<Eigen::Lower>().rankUpdate(on_terms.transpose());
   if (!term.closes_run) return;
   run_open_ = false;
   // G^T G = P^T L D L^T P, so M = D^(1/2) L^T P: at most n rows.
   const Eigen::LDLT<SmallMatrix, Eigen::Lower> ldlt(run_gram_);
   const SmallMatrix pl =
       ldlt.transpositionsP().transpose() * SmallMatrix(ldlt.matrixL());
-  std::array<int, kMaxCompressedTerms> offset{};
-  for (int a = 0, o = 0; a < term.num_blocks; ++a) {
-    if (!term.in_panel[a]) continue;
-    for (int i = 0; i < n; ++i) {
-      if (map.terms[i].block == a) offset[i] = o;
-    }
-    o += term.size[a];
-  }
+  // Blocks 0..n-1 are the panel's, in order (CompressibleCost).
+  std::array<int, kMaxCompressedTerms + 1> offset{};
+  for (int a = 0; a < n; ++a) offset[a + 1] = offset[a] + term.size[a];
   for (int r = 0; r < n; ++r) {
     const double d = ldlt.vectorD()[r];
     if (!(d > 0.0)) continue;
     const double scale = std::sqrt(d);
     double* out = PanelRows(term, 1, h);
-    std::fill(out, out + panel_.size() - (out - panel_.data()), 0.0);
+    std::fill(out, out + offset[n], 0.0);
     for (int i = 0; i < n; ++i) {
-      Eigen::Map<Eigen::VectorXd>(out + offset[i], map.terms[i].phi->size()) =
-          (scale * pl(i, r)) * *map.terms[i].phi;
+      const PoseTerm& t = map.terms[i];
+      Eigen::Map<Eigen::VectorXd>(out + offset[t.block], t.phi->size()) =
+          (scale * pl(i, r)) * *t.phi;
     }
   }
 }

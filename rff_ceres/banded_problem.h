@@ -129,10 +129,11 @@ class BandedProblem {
     const char* in_panel = nullptr;
     int num_panel_blocks = 0;
     // Set on each of a run of PoseMapped costs of one pose map (the costs
-    // at one time) whose rows outnumber the map's terms: their panel rows
-    // G Phi join the panel as the rows of M Phi, M^T M = G^T G, the last
-    // of the run (`closes_run`) adding them.
-    const PoseMap* compressed_map = nullptr;
+    // at one time) whose rows outnumber the map's terms. Such a cost is
+    // evaluated at its pose (EvaluateOnPose); its rows on the weights, G Phi,
+    // join the panel as the rows of M Phi, M^T M = G^T G, which the last of
+    // the run (`closes_run`) adds.
+    const PoseMapped* compressed = nullptr;
     bool closes_run = false;
   };
 
@@ -142,9 +143,13 @@ class BandedProblem {
   // The rows of `rows` more rows in the panel, after flushing it when full
   // or on other blocks than the term's panel blocks.
   double* PanelRows(const Term& term, int rows, EnvelopeMatrix* h);
-  // Adds the last Evaluate's rows to the run's G^T G, and at its end the
-  // rows of M Phi to the panel.
-  void AccumulateRun(const Term& term, EnvelopeMatrix* h);
+  // A compressed term's cost at x, its corrected residual, its rows G on
+  // its pose map's terms and on its landmark in the buffers below.
+  bool EvaluateOnPose(const Term& term, const Eigen::VectorXd& x, double* cost);
+  // g and H from the last EvaluateOnPose: the landmark's products at once,
+  // the weights' through the run's G^T G, and at the run's end the rows of
+  // M Phi to the panel.
+  void AccumulateRun(const Term& term, Eigen::VectorXd* g, EnvelopeMatrix* h);
   // One term's cost at x and, with `jacobians`, its corrected residual and
   // Jacobian blocks in the buffers below.
   bool Evaluate(const Term& term, const Eigen::VectorXd& x, bool jacobians,
@@ -179,12 +184,13 @@ class BandedProblem {
   std::vector<int> panel_columns_, panel_sizes_;
   std::vector<double> panel_;
   int panel_rows_ = 0;
-  // The open run: G^T G of its pose-space rows, 1 / |phi|^2 of its terms.
+  // The last EvaluateOnPose's rows (row-major): on the pose (x, y, theta),
+  // on the pose map's terms, on the landmark.
+  std::vector<double> pose_rows_, term_rows_, landmark_rows_;
+  // The open run's G^T G.
   using SmallMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0,
                                     kMaxCompressedTerms, kMaxCompressedTerms>;
   SmallMatrix run_gram_;
-  Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxCompressedTerms, 1>
-      run_inverse_norms_;
   bool run_open_ = false;
 };
 

@@ -114,6 +114,38 @@ inline void ExpectSameCost(const ceres::CostFunction& analytic,
   std::vector<double> r3(m);
   ASSERT_TRUE(analytic.Evaluate(blocks.data(), r3.data(), nullptr));
   for (int r = 0; r < m; ++r) EXPECT_EQ(r3[r], r1[r]);
+  // A cost seen through pose maps: its gradients at the poses, through its
+  // maps, give the same Jacobians.
+  const auto* mapped = dynamic_cast<const PoseMapped*>(&analytic);
+  if (mapped == nullptr) return;
+  const int poses = mapped->num_pose_maps();
+  std::vector<double> r4(m), on_poses(3 * m * poses), on_landmark(2 * m);
+  ASSERT_TRUE(mapped->EvaluateAtPoses(blocks.data(), r4.data(), on_poses.data(),
+                                      on_landmark.data()));
+  std::vector<std::vector<double>> through_maps(sizes.size());
+  for (size_t i = 0; i < sizes.size(); ++i) {
+    through_maps[i].assign(m * sizes[i], 0.0);
+  }
+  for (int k = 0; k < poses; ++k) {
+    for (const PoseTerm& term : mapped->pose_map(k).terms) {
+      for (int r = 0; r < m; ++r) {
+        const double g = on_poses[3 * m * k + 3 * r + term.coordinate];
+        for (int e = 0; e < term.phi->size(); ++e) {
+          through_maps[term.block][r * sizes[term.block] + e] +=
+              g * (*term.phi)[e];
+        }
+      }
+    }
+  }
+  if (mapped->has_landmark()) through_maps.back() = on_landmark;
+  for (int r = 0; r < m; ++r) EXPECT_EQ(r4[r], r1[r]);
+  for (size_t i = 0; i < sizes.size(); ++i) {
+    for (size_t k = 0; k < j1[i].size(); ++k) {
+      EXPECT_NEAR(through_maps[i][k], j1[i][k],
+                  1e-12 * (1.0 + std::abs(j1[i][k])))
+          << "block " << i << " entry " << k;
+    }
+  }
 }
 
 // Random values for blocks of the given sizes.
