@@ -266,8 +266,9 @@ void BandedProblem::MarkCompressedRuns() {
                     terms_[end].column)) {
       rows += terms_[end++].cost->num_residuals();
     }
-    // Fewer rows than terms would only grow the panel.
-    if (rows > static_cast<int>(map.terms.size())) {
+    // A run gives the panel at most one row per pose coordinate: with
+    // fewer rows than that it would only grow.
+    if (rows > 3) {
       for (std::size_t k = begin; k < end; ++k) {
         terms_[k].compressed = costs[k];
       }
@@ -462,17 +463,10 @@ bool BandedProblem::EvaluateOnPose(const Term& term, const Eigen::VectorXd& x,
   }
   const LossCorrection correction(term.loss, residual.squaredNorm());
   *cost = correction.cost;
-  // Row r on term i's block is (dr/dpose)(r, c_i) phi_i^T (pose_map.h).
-  const PoseMap& map = term.compressed->pose_map(0);
-  const int n = static_cast<int>(map.terms.size());
-  term_rows_.resize(static_cast<std::size_t>(rows) * n);
-  for (int r = 0; r < rows; ++r) {
-    for (int i = 0; i < n; ++i) {
-      term_rows_[r * n + i] = pose_rows_[3 * r + map.terms[i].coordinate];
-    }
-  }
-  if (!correction.CorrectRows(residual, term_rows_.data(), n) ||
-      (term.compressed->has_landmark() &&
+  const bool landmark =
+      term.compressed->has_landmark() && term.column[term.num_blocks - 1] >= 0;
+  if (!correction.CorrectRows(residual, pose_rows_.data(), 3) ||
+      (landmark &&
        !correction.CorrectRows(residual, landmark_rows_.data(), 2))) {
     return false;
   }
@@ -542,69 +536,67 @@ double* BandedProblem::PanelRows(const Term& term, int rows,
 
 void BandedProblem::AccumulateRun(const Term& term, Eigen::VectorXd* g,
                                   EnvelopeMatrix* h) {
+  // Row r on term i's block is G(r, c_i) phi_i^T (pose_map.h).
   const PoseMap& map = term.compressed->pose_map(0);
   const int n = static_cast<int>(map.terms.size());
   const int rows = static_cast<int>(residual_buffer_.size());
-  using RowMajor =
+  using Rows =
       Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
-  const Eigen::Map<const RowMajor> on_terms(term_rows_.data(), rows, n);
+  const Eigen::Map<const Rows> on_pose(pose_rows_.data(), rows, 3);
   const Eigen::Map<const Eigen::VectorXd> residual(residual_buffer_.data(),
                                                    rows);
-  // The weights' gradient: term i's block gains (G^T r)_i phi_i.
-  const Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxCompressedTerms, 1>
-      term_gradient = on_terms.transpose() * residual;
-  for (int i = 0; i < n; ++i) {
-    const PoseTerm& t = map.terms[i];
+  Eigen::Vector3d pose_gradient;
+  pose_gradient.noalias() = on_pose.transpose() * residual;
+  for (const PoseTerm& t : map.terms) {
     g->segment(term.column[t.block], t.phi->size()) +=
-        term_gradient[i] * *t.phi;
+        pose_gradient[t.coordinate] * *t.phi;
   }
   const int l = term.compressed->has_landmark() ? term.column[n] : -1;
   if (l >= 0) {
-    const Eigen::Map<const RowMajor> on_landmark(landmark_rows_.data(), rows,
-                                                 2);
-    g->segment(l, 2) += on_landmark.transpose() * residual;
-    const Eigen::Matrix2d ll = on_landmark.transpose() * on_landmark;
+    const Eigen::Map<const Rows> on_landmark(landmark_rows_.data(), rows, 2);
+    Eigen::Vector2d landmark_gradient;
+    landmark_gradient.noalias() = on_landmark.transpose() * residual;
+    g->segment<2>(l) += landmark_gradient;
+    Eigen::Matrix2d ll;
+    ll.noalias() = on_landmark.transpose() * on_landmark;
     (*h)(l, l) += ll(0, 0);
     (*h)(l + 1, l) += ll(1, 0);
     (*h)(l + 1, l + 1) += ll(1, 1);
-    // The landmark's products with term i's block: C(j, i) phi_i.
-    const Eigen::Matrix<double, 2, Eigen::Dynamic, Eigen::RowMajor, 2,
-                        kMaxCompressedTerms>
-        c = on_landmark.transpose() * on_terms;
-    for (int i = 0; i < n; ++i) {
-      const PoseTerm& t = map.terms[i];
+    // The landmark's products with term i's block: C(j, c_i) phi_i^T.
+    Eigen::Matrix<double, 2, 3, Eigen::RowMajor> c;
+    c.noalias() = on_landmark.transpose() * on_pose;
+    for (const PoseTerm& t : map.terms) {
       const int b = term.column[t.block];
-      const int size = static_cast<int>(t.phi->size());
       for (int j = 0; j < 2; ++j) {  // Row l + j of H: l > b.
-        Eigen::Map<Eigen::RowVectorXd>(&(*h)(l + j, b), size) +=
-            c(j, i) * t.phi->transpose();
+        Eigen::Map<Eigen::RowVectorXd>(&(*h)(l + j, b), t.phi->size()) +=
+            c(j, t.coordinate) * t.phi->transpose();
       }
     }
   }
   if (!run_open_) {
-    run_gram_.setZero(n, n);
+    run_gram_.setZero();
     run_open_ = true;
   }
-  run_gram_.selfadjointView<Eigen::Lower>().rankUpdate(on_terms.transpose());
+  run_gram_.noalias() += on_pose.transpose() * on_pose;
   if (!term.closes_run) return;
   run_open_ = false;
-  // G^T G = P^T L D L^T P, so M = D^(1/2) L^T P: at most n rows.
-  const Eigen::LDLT<SmallMatrix, Eigen::Lower> ldlt(run_gram_);
-  const SmallMatrix pl =
-      ldlt.transpositionsP().transpose() * SmallMatrix(ldlt.matrixL());
+  // G^T G = P^T L D L^T P, so R = D^(1/2) L^T P: row r puts
+  // R(r, c_i) phi_i on term i's block.
+  const Eigen::LDLT<Eigen::Matrix3d> ldlt(run_gram_);
+  const Eigen::Matrix3d pl =
+      ldlt.transpositionsP().transpose() * Eigen::Matrix3d(ldlt.matrixL());
   // Blocks 0..n-1 are the panel's, in order (CompressibleCost).
   std::array<int, kMaxCompressedTerms + 1> offset{};
   for (int a = 0; a < n; ++a) offset[a + 1] = offset[a] + term.size[a];
-  for (int r = 0; r < n; ++r) {
+  for (int r = 0; r < 3; ++r) {
     const double d = ldlt.vectorD()[r];
     if (!(d > 0.0)) continue;
     const double scale = std::sqrt(d);
     double* out = PanelRows(term, 1, h);
     std::fill(out, out + offset[n], 0.0);
-    for (int i = 0; i < n; ++i) {
-      const PoseTerm& t = map.terms[i];
+    for (const PoseTerm& t : map.terms) {
       Eigen::Map<Eigen::VectorXd>(out + offset[t.block], t.phi->size()) =
-          (scale * pl(i, r)) * *t.phi;
+          (scale * pl(t.coordinate, r)) * *t.phi;
     }
   }
 }

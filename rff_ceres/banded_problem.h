@@ -129,10 +129,11 @@ class BandedProblem {
     const char* in_panel = nullptr;
     int num_panel_blocks = 0;
     // Set on each of a run of PoseMapped costs of one pose map (the costs
-    // at one time) whose rows outnumber the map's terms. Such a cost is
-    // evaluated at its pose (EvaluateOnPose); its rows on the weights, G Phi,
-    // join the panel as the rows of M Phi, M^T M = G^T G, which the last of
-    // the run (`closes_run`) adds.
+    // at one time) with more than 3 rows in all. Such a cost is evaluated at
+    // its pose (EvaluateOnPose): its rows on the weights are G Phi, G its
+    // rows on the pose (x, y, theta), and the run's join the panel as the
+    // at most 3 rows R Phi, R^T R = G^T G, which the last of the run
+    // (`closes_run`) adds.
     const PoseMapped* compressed = nullptr;
     bool closes_run = false;
   };
@@ -144,7 +145,7 @@ class BandedProblem {
   // or on other blocks than the term's panel blocks.
   double* PanelRows(const Term& term, int rows, EnvelopeMatrix* h);
   // A compressed term's cost at x, its corrected residual, its rows G on
-  // its pose map's terms and on its landmark in the buffers below.
+  // its pose and on its landmark in the buffers below.
   bool EvaluateOnPose(const Term& term, const Eigen::VectorXd& x, double* cost);
   // g and H from the last EvaluateOnPose: the landmark's products at once,
   // the weights' through the run's G^T G, and at the run's end the rows of
@@ -184,13 +185,11 @@ class BandedProblem {
   std::vector<int> panel_columns_, panel_sizes_;
   std::vector<double> panel_;
   int panel_rows_ = 0;
-  // The last EvaluateOnPose's rows (row-major): on the pose (x, y, theta),
-  // on the pose map's terms, on the landmark.
-  std::vector<double> pose_rows_, term_rows_, landmark_rows_;
+  // The last EvaluateOnPose's rows (row-major): on the pose (x, y, theta)
+  // and on the landmark.
+  std::vector<double> pose_rows_, landmark_rows_;
   // The open run's G^T G.
-  using SmallMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0,
-                                    kMaxCompressedTerms, kMaxCompressedTerms>;
-  SmallMatrix run_gram_;
+  Eigen::Matrix3d run_gram_;
   bool run_open_ = false;
 };
 

@@ -8,6 +8,7 @@
 #include "ceres/autodiff_cost_function.h"
 #include "ceres/ceres.h"
 #include "costs/pose_map.h"
+#include "costs/pose_prior_cost.h"
 #include "costs/range_bearing_cost.h"
 #include "gtest/gtest.h"
 #include "rff_ceres/banded_problem.h"
@@ -534,15 +535,19 @@ TEST(BandedMinimizerTest, PanelProductsAreThoseOfTheJacobian) {
 }
 
 // Windows of x, y and theta weights (12 each) seen through pose maps, as
-// feature trajectories are: at each of 5 times a window, one range-bearing
-// or three of different landmarks (every second under a Cauchy loss), and
-// four at the last time, blended with the next window's features.
+// feature trajectories are. At each of 5 times a window: one range-bearing,
+// or three of different landmarks, every third under a Cauchy loss (rho''
+// < 0) and every third under a tolerant one (rho'' > 0: the full
+// correction); at the window's second time also a pose prior; four at the
+// last time, blended with the next window's features. The last landmark
+// is held constant.
 struct PoseWindowProblem {
   static constexpr int kD = 12;
   std::vector<std::vector<double>> weights;  // x, y, theta of each window.
   std::vector<Eigen::Vector2d> landmarks;
   std::unique_ptr<ceres::Problem> problem;
-  ceres::CauchyLoss loss{1.0};
+  ceres::CauchyLoss cauchy{1.0};
+  ceres::TolerantLoss tolerant{0.5, 0.5};
 
   explicit PoseWindowProblem(int n) : weights(3 * n), landmarks(4) {
     ceres::Problem::Options options;
@@ -560,6 +565,7 @@ struct PoseWindowProblem {
         PoseMap map;
         map.mean = Eigen::Vector3d(0.1 * k, 0.2, 0.3);
         const bool blended = t == 4 && k + 1 < n;
+        std::vector<double*> blocks;
         for (int w = k; w <= (blended ? k + 1 : k); ++w) {
           auto position = std::make_shared<Eigen::VectorXd>(kD);
           auto heading = std::make_shared<Eigen::VectorXd>(kD);
@@ -571,23 +577,28 @@ struct PoseWindowProblem {
           map.terms.push_back({first, 0, position});
           map.terms.push_back({first + 1, 1, position});
           map.terms.push_back({first + 2, 2, heading});
-        }
-        std::vector<double*> blocks;
-        for (int w = k; w <= (blended ? k + 1 : k); ++w) {
           for (int c = 0; c < 3; ++c)
             blocks.push_back(weights[3 * w + c].data());
         }
+        if (t == 1) {
+          problem->AddResidualBlock(
+              new PosePriorCost(map, Eigen::Vector3d(0.1 * k, 0.2, 0.3),
+                                Eigen::Vector3d(0.5, 0.5, 0.1)),
+              nullptr, blocks);
+        }
         const int costs = t % 3 == 0 ? 1 : (t == 4 ? 4 : 3);
         for (int o = 0; o < costs; ++o, ++count) {
+          ceres::LossFunction* losses[] = {nullptr, &cauchy, &tolerant};
           blocks.push_back(landmarks[(k + o) % landmarks.size()].data());
           problem->AddResidualBlock(
               new RangeBearingCost(map, 3.0 + 0.1 * std::sin(count),
                                    0.2 * std::cos(count), 0.1, 0.05),
-              count % 2 == 0 ? &loss : nullptr, blocks);
+              losses[count % 3], blocks);
           blocks.pop_back();
         }
       }
     }
+    problem->SetParameterBlockConstant(landmarks.back().data());
   }
 
   BandedColumns Columns() {
@@ -598,14 +609,14 @@ struct PoseWindowProblem {
   }
 };
 
-// Costs at one time whose rows outnumber their pose map's terms enter the
-// panel as at most one row per term; H and g stay Ceres's.
+// Costs at one time with more than 3 rows in all enter the panel as at
+// most 3 rows; H and g stay Ceres's.
 TEST(BandedMinimizerTest, CompressedPoseRunsGiveTheProductsOfTheJacobian) {
   static_assert(kMinPanelWidth <= PoseWindowProblem::kD);
   PoseWindowProblem windows(6);
   BandedProblem banded(*windows.problem, windows.Columns());
-  // The times with three or four costs (6 rows over 3 terms, 8 over 6 where
-  // blended) each make a run; those with one (2 rows over 3) are left.
+  // The times with three or four range-bearings (6 or 8 rows; 9 with the
+  // pose prior) each make a run; those with one (2 rows) are left.
   EXPECT_EQ(banded.compressed_runs(), 6 * 3);
   const Eigen::VectorXd x = banded.Gather();
   EnvelopeMatrix h(banded.envelope_first());
