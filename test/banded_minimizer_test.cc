@@ -481,13 +481,16 @@ struct WindowProblem {
   }
 };
 
-// H, g and the cost of `banded` at its variables' values are those of
-// Ceres's own Jacobian of `problem`, in the banded column order.
+// H, g and the cost `banded` linearises to at its variables' values are
+// those of Ceres's own Jacobian of `problem`, in the banded column order.
 void ExpectCeresLinearization(ceres::Problem& problem,
                               const BandedColumns& columns,
-                              const BandedProblem& banded, double cost,
-                              const Eigen::VectorXd& g,
-                              const EnvelopeMatrix& h) {
+                              BandedProblem& banded) {
+  const Eigen::VectorXd x = banded.Gather();
+  EnvelopeMatrix h(banded.envelope_first());
+  Eigen::VectorXd g;
+  double cost;
+  ASSERT_TRUE(banded.Linearize(x, &cost, &g, &h));
   ceres::Problem::EvaluateOptions options;
   options.parameter_blocks = BandedBlockOrder(problem, columns);
   double expected_cost;
@@ -524,14 +527,7 @@ TEST(BandedMinimizerTest, PanelProductsAreThoseOfTheJacobian) {
   WindowProblem windows(12, 150);
   BandedProblem banded(*windows.problem, windows.Columns());
   ASSERT_EQ(banded.num_columns(), 12 * 12 + 2 * 7);
-  const Eigen::VectorXd x = banded.Gather();
-  EnvelopeMatrix h(banded.envelope_first());
-  Eigen::VectorXd g;
-  double cost;
-  ASSERT_TRUE(banded.Linearize(x, &cost, &g, &h));
-
-  ExpectCeresLinearization(*windows.problem, windows.Columns(), banded, cost, g,
-                           h);
+  ExpectCeresLinearization(*windows.problem, windows.Columns(), banded);
 }
 
 // Windows of x, y and theta weights (12 each) seen through pose maps, as
@@ -618,13 +614,7 @@ TEST(BandedMinimizerTest, CompressedPoseRunsGiveTheProductsOfTheJacobian) {
   // The times with three or four range-bearings (6 or 8 rows; 9 with the
   // pose prior) each make a run; those with one (2 rows) are left.
   EXPECT_EQ(banded.compressed_runs(), 6 * 3);
-  const Eigen::VectorXd x = banded.Gather();
-  EnvelopeMatrix h(banded.envelope_first());
-  Eigen::VectorXd g;
-  double cost;
-  ASSERT_TRUE(banded.Linearize(x, &cost, &g, &h));
-  ExpectCeresLinearization(*windows.problem, windows.Columns(), banded, cost, g,
-                           h);
+  ExpectCeresLinearization(*windows.problem, windows.Columns(), banded);
 }
 
 // A linearisation that fails part way (a weight of the last window not
