@@ -34,7 +34,8 @@ struct PoseMap {
 
 // A cost that sees poses only through PoseMaps (PoseCost): row r of the
 // Jacobian of term i's block is (dr/dpose)(r, c_i) phi_i^T, so the rows of
-// costs at one time span at most one row per term (banded_problem.cc).
+// the costs at one time span at most the pose's 3 directions
+// (banded_pose_runs.cc).
 class PoseMapped {
  public:
   virtual ~PoseMapped() = default;

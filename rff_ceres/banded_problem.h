@@ -149,7 +149,7 @@ class BandedProblem {
   bool EvaluateOnPose(const Term& term, const Eigen::VectorXd& x, double* cost);
   // g and H from the last EvaluateOnPose: the landmark's products at once,
   // the weights' through the run's G^T G, and at the run's end the rows of
-  // M Phi to the panel.
+  // R Phi to the panel (banded_pose_runs.cc).
   void AccumulateRun(const Term& term, Eigen::VectorXd* g, EnvelopeMatrix* h);
   // One term's cost at x and, with `jacobians`, its corrected residual and
   // Jacobian blocks in the buffers below.

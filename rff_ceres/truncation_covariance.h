@@ -16,9 +16,9 @@
 // and landmark l's error G_l G_l^T more. Where the data pin a pose the
 // estimate follows the missed motion (Phi G ~ Psi) and little is added; in
 // a gap nothing follows it and its whole prior variance is (the exact GP's
-// Laplace covariance, against which test/truncation_covariance_test.cc
-// checks it). FITC-like |Psi(t)|^2 alone over-counts the first and misses
-// what the landmarks absorb.
+// Laplace covariance, against which
+// test/exact_gp/truncation_covariance_test.cc checks it). FITC-like |Psi(t)|^2
+// alone over-counts the first and misses what the landmarks absorb.
 #ifndef RFF_CERES_TRUNCATION_COVARIANCE_H_
 #define RFF_CERES_TRUNCATION_COVARIANCE_H_
 
