@@ -73,6 +73,12 @@ class BandedProblem {
   // Whether some residual has wide timed blocks (kMinPanelWidth): their
   // products are formed a panel at a time.
   bool has_panels() const { return has_panels_; }
+  // Whether the envelope beats a fill-reducing sparse Cholesky here
+  // (envelope_cholesky.h): feature windows' panels at any fill, narrow
+  // states while the factorisation keeps within the work bound.
+  bool BeatsSparseCholesky() const {
+    return has_panels_ || Size().WorkWithinBound();
+  }
   // The runs of costs at one time whose panel rows are compressed (Term).
   int compressed_runs() const { return compressed_runs_; }
   int num_variable_blocks() const {

@@ -233,8 +233,7 @@ bool RunSolve(const SolverOptions& solver, ceres::Solver::Options ceres_options,
                       "the %.3g of the dense reduced system",
                       size.multiply_adds, dense_work);
         why = text;
-      } else if (!asked && !dense_schur && !banded->has_panels() &&
-                 work > kMaxEnvelopeWorkPerVariable) {
+      } else if (!asked && !dense_schur && !banded->BeatsSparseCholesky()) {
         // Landmarks seen over long stretches fill their rows of the factor;
         // a fill-reducing sparse Cholesky then does better on narrow
         // states. Feature windows' J^T J costs Ceres more than the fill

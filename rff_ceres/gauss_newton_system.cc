@@ -10,6 +10,7 @@
 #include "Eigen/LU"
 #include "rff_ceres/banded_minimizer.h"
 #include "rff_ceres/banded_problem.h"
+#include "rff_ceres/ceres_solve.h"
 #include "rff_ceres/variance_components.h"
 
 namespace rff {
@@ -179,13 +180,18 @@ bool FactorizeBanded(SlamProblem* problem, BandedSystem* system) {
     system->factor = std::move(kept.hessian);
     return system->factor->Factorize();
   }
-  if (problem->model().HasDenseReducedSystem()) return false;
   const BandedColumns columns = problem->BandColumns();
   std::string why;
   if (!BandedSolvable(*problem->problem(), columns, &why)) return false;
   system->banded = problem->BandedLayout(columns);
   BandedProblem& banded = *system->banded;
-  if (!EnvelopeAffordable(banded.Size())) return false;
+  if (!EnvelopeAffordable(banded)) return false;
+  // Feature weights where the envelope costs no more than their dense
+  // reduced system, as auto chooses for the solve (RunSolve).
+  if (problem->model().HasDenseReducedSystem() &&
+      banded.Size().multiply_adds > DenseReducedWork(problem)) {
+    return false;
+  }
   system->x = banded.Gather();
   system->factor = std::make_unique<EnvelopeMatrix>(banded.envelope_first());
   double cost;
@@ -284,6 +290,11 @@ double GaussNewtonDecrease(SlamProblem* problem, bool* exact) {
 bool EnvelopeAffordable(const BandedSize& size) {
   return static_cast<double>(size.entries) <= kMaxDenseEntries &&
          size.WorkWithinBound();
+}
+
+bool EnvelopeAffordable(const BandedProblem& banded) {
+  return static_cast<double>(banded.Size().entries) <= kMaxDenseEntries &&
+         banded.BeatsSparseCholesky();
 }
 
 bool SchurFormFits(int t, Eigen::Index m) {

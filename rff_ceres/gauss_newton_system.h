@@ -56,6 +56,9 @@ bool SchurFormFits(int t, Eigen::Index m);
 // memory of the dense forms and costs at most kMaxEnvelopeWorkPerVariable
 // per variable.
 bool EnvelopeAffordable(const BandedSize& size);
+// The same for a banded problem, whose feature windows' panels beat a
+// sparse Cholesky at any fill (BandedProblem::BeatsSparseCholesky).
+bool EnvelopeAffordable(const BandedProblem& banded);
 
 // How a GaussNewtonSystem is factorised.
 enum class Factorization {

@@ -68,6 +68,10 @@ bool FitModelToPosesOnce(const std::vector<TimedPose>& poses,
   ceres::Solver::Options options;
   options.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
   options.max_num_iterations = 20;
+  // The pose maps are affine in the weights and the staged targets keep
+  // the headings off their wrap: linear least squares, whose undamped
+  // first step is the minimum and whose second confirms it.
+  options.initial_trust_region_radius = options.max_trust_region_radius;
   options.logging_type = ceres::SILENT;
   ceres::Solver::Summary summary;
   // The model's blocks in time order: a narrow envelope (feature windows,
@@ -77,7 +81,7 @@ bool FitModelToPosesOnce(const std::vector<TimedPose>& poses,
   std::unique_ptr<BandedProblem> banded;
   if (BandedSolvable(problem, columns, &why)) {
     banded = std::make_unique<BandedProblem>(problem, columns);
-    if (!banded->Size().WorkWithinBound()) banded.reset();
+    if (!banded->BeatsSparseCholesky()) banded.reset();
   }
   if (banded) {
     MinimizeBanded(options, banded.get(), &problem, &summary);

@@ -12,6 +12,7 @@
 #include "costs/weight_prior_cost.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
+#include "rff_ceres/banded_problem.h"
 #include "rff_ceres/ceres_solve.h"
 #include "rff_ceres/feature_trajectory.h"
 #include "rff_ceres/io/text_parser.h"
@@ -300,6 +301,73 @@ TEST(PosteriorCovarianceTest, MatchesTheDenseInverseWithWindowedWeights) {
       EXPECT_NEAR(landmarks[k].sxy, expected(0, 1), 1e-9 * expected.norm());
       EXPECT_NEAR(landmarks[k].syy, expected(1, 1), 1e-9 * expected.norm());
     }
+  }
+}
+
+// Many wide feature windows (blocks past kMinPanelWidth, a factorisation
+// past kMaxEnvelopeWorkPerVariable) and no H kept from a solve: the
+// envelope, cheaper than the dense reduced system, gives what the selected
+// inverse gives.
+TEST(PosteriorCovarianceTest, ManyWideWindowsUseTheEnvelope) {
+  SimulationOptions sim = PaperOptions(5);
+  sim.num_steps = 200;
+  sim.num_landmarks = 12;
+  Dataset dataset;
+  std::string error;
+  ASSERT_TRUE(Simulate(sim, &dataset, &error)) << error;
+  FeatureTrajectoryOptions options;
+  options.position_kernel.name = "rbf";
+  options.position_kernel.lengthscale = 5.0;
+  options.position_kernel.variance = 100.0;
+  options.heading_kernel = options.position_kernel;
+  options.heading_kernel.variance = 0.25;
+  options.num_position_features = 40;
+  options.num_heading_features = 40;
+  options.segment_length = 40.0;
+  options.segment_overlap = 10.0;
+  std::unique_ptr<FeatureTrajectory> model = FeatureTrajectory::Create(
+      options, std::make_shared<PiecewiseLinearMean>(dataset.ground_truth), 0.0,
+      199.0, &error);
+  ASSERT_NE(model, nullptr) << error;
+  ASSERT_EQ(model->num_segments(), 5);
+  std::map<LandmarkId, Eigen::Vector2d> initial;
+  std::vector<Landmark> landmarks;
+  for (const Landmark& l : dataset.ground_truth_landmarks) {
+    initial[l.id] = Eigen::Vector2d(l.x + 0.3, l.y - 0.2);
+    landmarks.push_back(l);
+  }
+  SlamProblem problem(model.get(), ProblemOptions());
+  ASSERT_TRUE(problem.Build(dataset, initial, &error)) << error;
+  const BandedSize size = problem.BandedLayout(problem.BandColumns())->Size();
+  ASSERT_FALSE(size.WorkWithinBound());
+  ASSERT_LT(size.multiply_adds, DenseReducedWork(&problem));
+  std::vector<double> times;
+  for (int k = 0; k < 150; ++k) times.push_back(1.3 * k + 0.2);
+  CovarianceOptions selected = WithAlgorithm(ceres::SPARSE_QR);
+  selected.use_selected_inverse = true;
+  std::vector<Eigen::Matrix3d> expected, covariances;
+  std::vector<Landmark> expected_landmarks = landmarks;
+  CovarianceMethod method = CovarianceMethod::kCeres;
+  ASSERT_TRUE(ComputePosteriorCovariance(&problem, *model, times, selected,
+                                         &expected, &expected_landmarks, &error,
+                                         &method))
+      << error;
+  ASSERT_EQ(method, CovarianceMethod::kSelectedInverse);
+  ASSERT_TRUE(ComputePosteriorCovariance(&problem, *model, times,
+                                         CovarianceOptions(), &covariances,
+                                         &landmarks, &error, &method))
+      << error;
+  EXPECT_EQ(method, CovarianceMethod::kEnvelope);
+  for (std::size_t k = 0; k < times.size(); ++k) {
+    EXPECT_LT((covariances[k] - expected[k]).norm(), 1e-8 * expected[k].norm())
+        << "t = " << times[k];
+  }
+  for (std::size_t k = 0; k < landmarks.size(); ++k) {
+    const Landmark& e = expected_landmarks[k];
+    ASSERT_TRUE(landmarks[k].has_covariance);
+    EXPECT_NEAR(landmarks[k].sxx, e.sxx, 1e-8 * e.sxx);
+    EXPECT_NEAR(landmarks[k].sxy, e.sxy, 1e-8 * e.sxx);
+    EXPECT_NEAR(landmarks[k].syy, e.syy, 1e-8 * e.syy);
   }
 }
 
