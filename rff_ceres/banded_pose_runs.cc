@@ -91,6 +91,29 @@ void BandedProblem::MarkCompressedRuns() {
   }
 }
 
+double BandedProblem::ProductWork(bool compressed) const {
+  double work = 0.0;
+  for (const Term& term : terms_) {
+    int panel_width = 0, width = 0;
+    for (int a = 0; a < term.num_blocks; ++a) {
+      if (term.column[a] < 0) continue;
+      width += term.size[a];
+      if (term.in_panel[a]) panel_width += term.size[a];
+    }
+    const double rows = term.cost->num_residuals();
+    if (compressed && term.compressed != nullptr) {
+      // The run's 3 rows on the weights; its products with the landmark
+      // are formed per cost.
+      if (term.closes_run) work += 3.0 * panel_width * panel_width / 2.0;
+      work += rows *
+              (double(width) * width - double(panel_width) * panel_width) / 2.0;
+    } else {
+      work += rows * width * width / 2.0;
+    }
+  }
+  return work;
+}
+
 bool BandedProblem::EvaluateOnPose(const Term& term, const Eigen::VectorXd& x,
                                    double* cost) {
   const int rows = term.cost->num_residuals();

@@ -81,6 +81,11 @@ class BandedProblem {
   }
   // The runs of costs at one time whose panel rows are compressed (Term).
   int compressed_runs() const { return compressed_runs_; }
+  // The multiply-adds that form H from the rows: r w^2 / 2 for r rows of
+  // width w. Linearize's own, its compressed runs at 3 rows; with
+  // `compressed` false, every residual row's, as a solver that forms J^T J
+  // from the Jacobian pays.
+  double ProductWork(bool compressed) const;
   int num_variable_blocks() const {
     return static_cast<int>(variables_.size());
   }

@@ -183,6 +183,16 @@ double DenseReducedWork(SlamProblem* problem) {
   return parameters * parameters * parameters / 6.0;
 }
 
+StepWork EnvelopeAndDenseStepWork(SlamProblem* problem,
+                                  const BandedProblem& banded) {
+  StepWork work;
+  work.envelope =
+      banded.ProductWork(/*compressed=*/true) + banded.Size().multiply_adds;
+  work.dense_reduced =
+      banded.ProductWork(/*compressed=*/false) + DenseReducedWork(problem);
+  return work;
+}
+
 bool RunSolve(const SolverOptions& solver, ceres::Solver::Options ceres_options,
               SlamProblem* problem, SlamResult* result, std::string* error,
               bool keep_linearization) {
@@ -218,8 +228,9 @@ bool RunSolve(const SolverOptions& solver, ceres::Solver::Options ceres_options,
       const double bytes = 24.0 * static_cast<double>(size.entries);
       const double limit = MemoryLimitBytes(solver.max_memory_gb);
       const double work = size.multiply_adds / std::max(size.num_columns, 1);
-      const double dense_work =
-          !asked && dense_schur ? DenseReducedWork(problem) : 0.0;
+      const StepWork step = !asked && dense_schur
+                                ? EnvelopeAndDenseStepWork(problem, *banded)
+                                : StepWork();
       char text[160];
       if (bytes > limit) {
         std::snprintf(text, sizeof(text),
@@ -227,11 +238,11 @@ bool RunSolve(const SolverOptions& solver, ceres::Solver::Options ceres_options,
                       "%.3g GB allowed by --max_memory_gb",
                       bytes / 1e9, limit / 1e9);
         why = text;
-      } else if (!asked && dense_schur && size.multiply_adds > dense_work) {
+      } else if (!asked && dense_schur && step.envelope > step.dense_reduced) {
         std::snprintf(text, sizeof(text),
-                      "%.3g multiply-adds in its factorisation, more than "
-                      "the %.3g of the dense reduced system",
-                      size.multiply_adds, dense_work);
+                      "%.3g multiply-adds a step, more than the %.3g of the "
+                      "dense reduced system",
+                      step.envelope, step.dense_reduced);
         why = text;
       } else if (!asked && !dense_schur && !banded->BeatsSparseCholesky()) {
         // Landmarks seen over long stretches fill their rows of the factor;
@@ -250,8 +261,8 @@ bool RunSolve(const SolverOptions& solver, ceres::Solver::Options ceres_options,
         result->linear_solver = kBandedCholesky;
         result->linear_solver_reason =
             std::string(dense_schur
-                            ? "windowed weights whose envelope factorises in "
-                              "no more multiply-adds than the dense reduced "
+                            ? "feature weights whose envelope takes no more "
+                              "multiply-adds a step than the dense reduced "
                               "system"
                             : "banded states") +
             ": Levenberg-Marquardt on a Cholesky of the whole system in time "

@@ -10,6 +10,7 @@
 
 #include "ceres/iteration_callback.h"
 #include "ceres/solver.h"
+#include "rff_ceres/banded_problem.h"
 #include "rff_ceres/slam_problem.h"
 #include "rff_ceres/trajectory_model.h"
 
@@ -57,6 +58,17 @@ bool ToCeresOptions(const SolverOptions& options,
 // model's weights the solve moves, after the landmarks' elimination):
 // t^3 / 6.
 double DenseReducedWork(SlamProblem* problem);
+
+// The multiply-adds of a step on the envelope of `banded` (forming H from
+// its rows, compressed where costs share a time, and factorising it) and
+// on the dense reduced system (forming it from every row of J, as Ceres's
+// DENSE_SCHUR does, and its Cholesky). Auto solves feature weights on the
+// envelope where the first is at most the second.
+struct StepWork {
+  double envelope = 0.0, dense_reduced = 0.0;
+};
+StepWork EnvelopeAndDenseStepWork(SlamProblem* problem,
+                                  const BandedProblem& banded);
 
 // "auto" settles on AutoLinearSolverType; an explicit choice is obeyed.
 // Records the choice and why in result->linear_solver(_reason).

@@ -188,9 +188,9 @@ bool FactorizeBanded(SlamProblem* problem, BandedSystem* system) {
   if (!EnvelopeAffordable(banded)) return false;
   // Feature weights where the envelope costs no more than their dense
   // reduced system, as auto chooses for the solve (RunSolve).
-  if (problem->model().HasDenseReducedSystem() &&
-      banded.Size().multiply_adds > DenseReducedWork(problem)) {
-    return false;
+  if (problem->model().HasDenseReducedSystem()) {
+    const StepWork work = EnvelopeAndDenseStepWork(problem, banded);
+    if (work.envelope > work.dense_reduced) return false;
   }
   system->x = banded.Gather();
   system->factor = std::make_unique<EnvelopeMatrix>(banded.envelope_first());
