@@ -199,9 +199,8 @@ bool RunSolve(const SolverOptions& solver, ceres::Solver::Options ceres_options,
   problem->DropLinearization();
   const bool asked = IsBandedCholesky(solver.linear_solver);
   // Auto's dense reduced system (feature weights after the landmarks'
-  // elimination) against the envelope: the envelope where its factorisation
-  // costs no more than that system's, which Ceres forms from the Jacobian
-  // at every step besides.
+  // elimination) against the envelope: the envelope where its step costs
+  // no more than that system's (EnvelopeAndDenseStepWork).
   const bool dense_schur =
       ceres_options.linear_solver_type == ceres::DENSE_SCHUR;
   if (asked ||
