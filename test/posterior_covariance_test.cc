@@ -183,39 +183,58 @@ TEST(PosteriorCovarianceTest, UnknownLandmarkIsAnError) {
   EXPECT_EQ(error, "posterior covariance: landmark 4 is not in the problem");
 }
 
-// Windowed features (poses in two segments at the overlaps), range-bearing
-// observations and odometry: the block-pair assembly against the dense
-// inverse of J^T J over all parameters.
-TEST(PosteriorCovarianceTest, MatchesTheDenseInverseWithWindowedWeights) {
-  SimulationOptions sim = PaperOptions(5);
-  sim.num_steps = 60;
-  sim.num_landmarks = 12;
+// A simulated run of `steps` seconds, RBF features of `features` a
+// coordinate (x and y; theta `heading_features`) in windows of `segment`
+// s blended over `overlap` s, and its problem with the landmarks started
+// 0.36 m off.
+struct WindowedRun {
   Dataset dataset;
+  std::unique_ptr<FeatureTrajectory> model;
+  std::vector<Landmark> landmarks;
+  std::unique_ptr<SlamProblem> problem;
+};
+void BuildWindowedRun(int steps, int features, int heading_features,
+                      double segment, double overlap, WindowedRun* run) {
+  SimulationOptions sim = PaperOptions(5);
+  sim.num_steps = steps;
+  sim.num_landmarks = 12;
   std::string error;
-  ASSERT_TRUE(Simulate(sim, &dataset, &error)) << error;
+  ASSERT_TRUE(Simulate(sim, &run->dataset, &error)) << error;
   FeatureTrajectoryOptions options;
   options.position_kernel.name = "rbf";
   options.position_kernel.lengthscale = 5.0;
   options.position_kernel.variance = 100.0;
   options.heading_kernel = options.position_kernel;
   options.heading_kernel.variance = 0.25;
-  options.num_position_features = 8;
-  options.num_heading_features = 6;
-  options.segment_length = 20.0;
-  options.segment_overlap = 6.0;
-  std::unique_ptr<FeatureTrajectory> model = FeatureTrajectory::Create(
-      options, std::make_shared<PiecewiseLinearMean>(dataset.ground_truth), 0.0,
-      59.0, &error);
-  ASSERT_NE(model, nullptr) << error;
-  ASSERT_EQ(model->num_segments(), 3);
+  options.num_position_features = features;
+  options.num_heading_features = heading_features;
+  options.segment_length = segment;
+  options.segment_overlap = overlap;
+  run->model = FeatureTrajectory::Create(
+      options, std::make_shared<PiecewiseLinearMean>(run->dataset.ground_truth),
+      0.0, steps - 1.0, &error);
+  ASSERT_NE(run->model, nullptr) << error;
   std::map<LandmarkId, Eigen::Vector2d> initial;
-  std::vector<Landmark> landmarks;
-  for (const Landmark& l : dataset.ground_truth_landmarks) {
+  for (const Landmark& l : run->dataset.ground_truth_landmarks) {
     initial[l.id] = Eigen::Vector2d(l.x + 0.3, l.y - 0.2);
-    landmarks.push_back(l);
+    run->landmarks.push_back(l);
   }
-  SlamProblem problem(model.get(), ProblemOptions());
-  ASSERT_TRUE(problem.Build(dataset, initial, &error)) << error;
+  run->problem =
+      std::make_unique<SlamProblem>(run->model.get(), ProblemOptions());
+  ASSERT_TRUE(run->problem->Build(run->dataset, initial, &error)) << error;
+}
+
+// Windowed features (poses in two segments at the overlaps), range-bearing
+// observations and odometry: the block-pair assembly against the dense
+// inverse of J^T J over all parameters.
+TEST(PosteriorCovarianceTest, MatchesTheDenseInverseWithWindowedWeights) {
+  WindowedRun run;
+  ASSERT_NO_FATAL_FAILURE(BuildWindowedRun(60, 8, 6, 20.0, 6.0, &run));
+  FeatureTrajectory* model = run.model.get();
+  ASSERT_EQ(model->num_segments(), 3);
+  std::vector<Landmark>& landmarks = run.landmarks;
+  SlamProblem& problem = *run.problem;
+  std::string error;
   // Solved banded, the problem keeps its H: the envelope serves it once.
   SolverOptions solver;
   solver.linear_solver = "BANDED_CHOLESKY";
@@ -309,35 +328,13 @@ TEST(PosteriorCovarianceTest, MatchesTheDenseInverseWithWindowedWeights) {
 // envelope, cheaper than the dense reduced system, gives what the selected
 // inverse gives.
 TEST(PosteriorCovarianceTest, ManyWideWindowsUseTheEnvelope) {
-  SimulationOptions sim = PaperOptions(5);
-  sim.num_steps = 200;
-  sim.num_landmarks = 12;
-  Dataset dataset;
+  WindowedRun run;
+  ASSERT_NO_FATAL_FAILURE(BuildWindowedRun(200, 40, 40, 40.0, 10.0, &run));
+  const FeatureTrajectory& model = *run.model;
+  ASSERT_EQ(model.num_segments(), 5);
+  std::vector<Landmark>& landmarks = run.landmarks;
+  SlamProblem& problem = *run.problem;
   std::string error;
-  ASSERT_TRUE(Simulate(sim, &dataset, &error)) << error;
-  FeatureTrajectoryOptions options;
-  options.position_kernel.name = "rbf";
-  options.position_kernel.lengthscale = 5.0;
-  options.position_kernel.variance = 100.0;
-  options.heading_kernel = options.position_kernel;
-  options.heading_kernel.variance = 0.25;
-  options.num_position_features = 40;
-  options.num_heading_features = 40;
-  options.segment_length = 40.0;
-  options.segment_overlap = 10.0;
-  std::unique_ptr<FeatureTrajectory> model = FeatureTrajectory::Create(
-      options, std::make_shared<PiecewiseLinearMean>(dataset.ground_truth), 0.0,
-      199.0, &error);
-  ASSERT_NE(model, nullptr) << error;
-  ASSERT_EQ(model->num_segments(), 5);
-  std::map<LandmarkId, Eigen::Vector2d> initial;
-  std::vector<Landmark> landmarks;
-  for (const Landmark& l : dataset.ground_truth_landmarks) {
-    initial[l.id] = Eigen::Vector2d(l.x + 0.3, l.y - 0.2);
-    landmarks.push_back(l);
-  }
-  SlamProblem problem(model.get(), ProblemOptions());
-  ASSERT_TRUE(problem.Build(dataset, initial, &error)) << error;
   const BandedSize size = problem.BandedLayout(problem.BandColumns())->Size();
   ASSERT_FALSE(size.WorkWithinBound());
   ASSERT_LT(size.multiply_adds, DenseReducedWork(&problem));
@@ -348,12 +345,12 @@ TEST(PosteriorCovarianceTest, ManyWideWindowsUseTheEnvelope) {
   std::vector<Eigen::Matrix3d> expected, covariances;
   std::vector<Landmark> expected_landmarks = landmarks;
   CovarianceMethod method = CovarianceMethod::kCeres;
-  ASSERT_TRUE(ComputePosteriorCovariance(&problem, *model, times, selected,
+  ASSERT_TRUE(ComputePosteriorCovariance(&problem, model, times, selected,
                                          &expected, &expected_landmarks, &error,
                                          &method))
       << error;
   ASSERT_EQ(method, CovarianceMethod::kSelectedInverse);
-  ASSERT_TRUE(ComputePosteriorCovariance(&problem, *model, times,
+  ASSERT_TRUE(ComputePosteriorCovariance(&problem, model, times,
                                          CovarianceOptions(), &covariances,
                                          &landmarks, &error, &method))
       << error;
