@@ -102,11 +102,10 @@ double BandedProblem::ProductWork(bool compressed) const {
     }
     const double rows = term.cost->num_residuals();
     if (compressed && term.compressed != nullptr) {
-      // The run's 3 rows on the weights; its products with the landmark
-      // are formed per cost.
+      // The run's 3 rows on the weights; each cost's products with its
+      // landmark are formed once from its rows on the pose (AccumulateRun).
       if (term.closes_run) work += 3.0 * panel_width * panel_width / 2.0;
-      work += rows *
-              (double(width) * width - double(panel_width) * panel_width) / 2.0;
+      work += (double(width) * width - double(panel_width) * panel_width) / 2.0;
     } else {
       work += rows * width * width / 2.0;
     }

@@ -170,8 +170,7 @@ std::vector<int> TimeOrderPositions(SlamProblem* problem,
 
 bool FactorizeBanded(SlamProblem* problem, BandedSystem* system) {
   // The solve's own H at these values, when it left one: the same sums, and
-  // affordable, as the solve factorised it at every step (feature windows
-  // too, which auto solves banded at any fill).
+  // affordable, as the solve factorised it at every step.
   BandedLinearization kept;
   if (problem->TakeLinearization(&kept)) {
     system->banded = std::move(kept.banded);
@@ -185,12 +184,17 @@ bool FactorizeBanded(SlamProblem* problem, BandedSystem* system) {
   if (!BandedSolvable(*problem->problem(), columns, &why)) return false;
   system->banded = problem->BandedLayout(columns);
   BandedProblem& banded = *system->banded;
-  if (!EnvelopeAffordable(banded)) return false;
-  // Feature weights where the envelope costs no more than their dense
-  // reduced system, as auto chooses for the solve (RunSolve).
+  // As auto chooses for the solve (RunSolve): feature weights where the
+  // envelope's step costs no more than their dense reduced system's, other
+  // models where it beats a sparse Cholesky.
+  if (static_cast<double>(banded.Size().entries) > kMaxDenseEntries) {
+    return false;
+  }
   if (problem->model().HasDenseReducedSystem()) {
     const StepWork work = EnvelopeAndDenseStepWork(problem, banded);
     if (work.envelope > work.dense_reduced) return false;
+  } else if (!banded.BeatsSparseCholesky()) {
+    return false;
   }
   system->x = banded.Gather();
   system->factor = std::make_unique<EnvelopeMatrix>(banded.envelope_first());
@@ -290,11 +294,6 @@ double GaussNewtonDecrease(SlamProblem* problem, bool* exact) {
 bool EnvelopeAffordable(const BandedSize& size) {
   return static_cast<double>(size.entries) <= kMaxDenseEntries &&
          size.WorkWithinBound();
-}
-
-bool EnvelopeAffordable(const BandedProblem& banded) {
-  return static_cast<double>(banded.Size().entries) <= kMaxDenseEntries &&
-         banded.BeatsSparseCholesky();
 }
 
 bool SchurFormFits(int t, Eigen::Index m) {

@@ -56,9 +56,6 @@ bool SchurFormFits(int t, Eigen::Index m);
 // memory of the dense forms and costs at most kMaxEnvelopeWorkPerVariable
 // per variable.
 bool EnvelopeAffordable(const BandedSize& size);
-// The same for a banded problem, whose feature windows' panels beat a
-// sparse Cholesky at any fill (BandedProblem::BeatsSparseCholesky).
-bool EnvelopeAffordable(const BandedProblem& banded);
 
 // How a GaussNewtonSystem is factorised.
 enum class Factorization {
@@ -135,9 +132,11 @@ class GaussNewtonSystem {
 // residual blocks in the time-ordered envelope BANDED_CHOLESKY factorises,
 // and factorised: `banded` the problem's layout, `x` its values, `gradient`
 // J^T r; the H a BANDED_CHOLESKY solve kept at these values when there is
-// one (any model). False otherwise for a model with a dense reduced system
-// (features) and where the envelope does not serve (bounds, manifolds, too
-// costly, or H not positive definite to rounding).
+// one (any model). Otherwise built where the envelope serves as auto's
+// solve would take it: feature weights whose envelope step costs no more
+// than their dense reduced system's (EnvelopeAndDenseStepWork), other
+// models where it beats a sparse Cholesky; false where it does not serve
+// (bounds, manifolds, too costly, or H not positive definite to rounding).
 struct BandedSystem {
   std::shared_ptr<BandedProblem> banded;
   Eigen::VectorXd x, gradient;
@@ -147,9 +146,9 @@ bool FactorizeBanded(SlamProblem* problem, BandedSystem* system);
 
 // g^T H^-1 g / 2 at the problem's values, g = J^T r and H = J^T J of its
 // whitened, loss-corrected residuals: what the Gauss-Newton model still
-// expects to gain (a minimum leaves nothing). Banded states, and any model
-// a BANDED_CHOLESKY solve left its H for, solve with H's envelope factor
-// (FactorizeBanded); other models with H's Schur form where it costs no
+// expects to gain (a minimum leaves nothing). Models the envelope serves
+// solve with H's envelope factor (FactorizeBanded); others with H's Schur
+// form where it costs no
 // more than the bound below (few weights beside the landmarks); the rest
 // take at most 100 steps of conjugate gradients on J^T J with H's diagonal
 // as preconditioner, whose estimate rises towards the value from below

@@ -442,9 +442,9 @@ TEST(FactorizeBandedTest, DecrementToleranceReachesTheBandedLoop) {
 }
 
 // Feature windows solved by BANDED_CHOLESKY leave their H too: the
-// decrease is then exact (the dense value to rounding, where the conjugate
-// gradients give a bound), and the variance components' traces come from
-// the same probes through the envelope as through the sparse path.
+// decrease is then exact (the dense value to rounding), and the variance
+// components' traces come from the same probes through the envelope as
+// through the sparse path.
 TEST(FactorizeBandedTest, FeatureWindowsSolvedBandedLeaveTheirH) {
   SlamOptions options;
   options.prior = "rff";

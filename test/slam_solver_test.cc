@@ -588,8 +588,9 @@ TEST(SlamSolverTest, RunsFarApartInTimeSolveAsEachAlone) {
   EXPECT_NEAR(joint_result.summary.final_cost,
               first_result.summary.final_cost + later_result.summary.final_cost,
               1e-6);
-  // Solves converged to steps of 1e-17 of x still land up to 2e-9 m
-  // apart from other starts (the costs equal to 1e-15): rounding's width.
+  // The joint solve's steps fall to 1e-17 of x with |g| still 5e-7 (the
+  // single run's 2e-9): where it stops moves by 2e-9 m with the start,
+  // its cost equal to 1e-15.
   EXPECT_NEAR(PartApe(joint, joint_result, 0.0, 1e3, 0, id_offset),
               ApeTranslation(first, first_result), 1e-8);
   EXPECT_NEAR(PartApe(joint, joint_result, dt, dt + 1e3, id_offset, id_offset),
