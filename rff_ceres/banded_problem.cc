@@ -159,22 +159,17 @@ BandedProblem::BandedProblem(const ceres::Problem& problem,
     (variable ? terms_ : fixed_terms_).push_back(term);
   }
   envelope_first_ = EnvelopeFirst();
+  size_.num_columns = num_columns_;
+  for (int i = 0; i < num_columns_; ++i) {
+    size_.entries += i - envelope_first_[i] + 1;
+  }
+  size_.multiply_adds = EnvelopeMatrix::FactorizationWork(envelope_first_);
   MarkCompressedRuns();
 }
 
 int BandedProblem::ColumnOf(const double* block) const {
   const auto it = first_column_.find(block);
   return it == first_column_.end() ? -1 : it->second;
-}
-
-BandedSize BandedProblem::Size() const {
-  BandedSize size;
-  size.num_columns = num_columns_;
-  for (int i = 0; i < num_columns_; ++i) {
-    size.entries += i - envelope_first_[i] + 1;
-  }
-  size.multiply_adds = EnvelopeMatrix::FactorizationWork(envelope_first_);
-  return size;
 }
 
 std::vector<int> BandedProblem::EnvelopeFirst() const {

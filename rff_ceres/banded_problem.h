@@ -95,7 +95,8 @@ class BandedProblem {
   // The first column of a parameter block of the problem, -1 for a block
   // that is no variable (constant, or used by no residual).
   int ColumnOf(const double* block) const;
-  BandedSize Size() const;
+  // Fixed with the envelope at construction: a pass over its entries.
+  const BandedSize& Size() const { return size_; }
 
   // The variables' values as a state vector, and back.
   Eigen::VectorXd Gather() const;
@@ -187,6 +188,7 @@ class BandedProblem {
   bool has_panels_ = false;
   int compressed_runs_ = 0;
   std::vector<int> envelope_first_;
+  BandedSize size_;
   std::vector<const double*> parameters_;
   std::vector<std::vector<double>> jacobian_rows_;
   std::vector<double*> jacobian_pointers_;
