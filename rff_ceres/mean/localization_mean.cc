@@ -75,27 +75,35 @@ void AppendMapResiduals(const std::vector<MapObservation>& observations,
     // The measurement models of the solver's costs (costs/range_cost.h,
     // costs/bearing_cost.h), with the landmark's prior spread added.
     double range;
-    Eigen::Vector3d d_pose;
+    Eigen::Vector3d d_range;
     Eigen::Vector2d d_landmark;
-    RangeAndGradient(p, l.position, &range, &d_pose, &d_landmark);
+    RangeAndGradient(p, l.position, &range, &d_range, &d_landmark);
     if (o.HasRange()) {
       const double sigma =
           std::sqrt(o.sigma_range * o.sigma_range + l.sigma * l.sigma);
       MapResidualRow row;
       row.residual = (range - o.range) / sigma;
-      row.jacobian = d_pose.transpose() / sigma;
+      row.jacobian = d_range.transpose() / sigma;
       rows->push_back(row);
     }
     double bearing;
+    Eigen::Vector3d d_bearing;
     if (!o.HasBearing()) continue;
     MapResidualRow row;  // Zero where the landmark sits on the robot.
-    if (BearingAndGradient(p, l.position, &bearing, &d_pose, &d_landmark)) {
+    if (BearingAndGradient(p, l.position, &bearing, &d_bearing, &d_landmark)) {
       // The landmark's spread seen from range r subtends s / r radians.
       const double spread = l.sigma / std::max(range, kMinSpreadRange);
       const double sigma =
           std::sqrt(o.sigma_bearing * o.sigma_bearing + spread * spread);
       row.residual = WrapAngle(bearing - o.bearing) / sigma;
-      row.jacobian = d_pose.transpose() / sigma;
+      row.jacobian = d_bearing.transpose() / sigma;
+      // The sigma moves with the range: d(w / sigma) adds
+      // (w / sigma) (s / r)^2 / (sigma^2 r) dr. Left out, Gauss-Newton stops
+      // short of the minimum wherever the spread dominates the sigma.
+      if (range > kMinSpreadRange) {
+        row.jacobian += row.residual * spread * spread /
+                        (sigma * sigma * range) * d_range.transpose();
+      }
     }
     rows->push_back(row);
   }

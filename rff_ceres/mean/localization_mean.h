@@ -25,8 +25,8 @@ struct KnownLandmark {
   double sigma = 0.0;
 };
 
-// One whitened residual row of an observation against a known landmark, over
-// the unknowns (x, y, theta).
+// One whitened residual row of an observation against a known landmark, and
+// its derivative by the unknowns (x, y, theta).
 struct MapResidualRow {
   double residual = 0.0;
   Eigen::RowVector3d jacobian = Eigen::RowVector3d::Zero();
