@@ -3,7 +3,8 @@
 // - BM_Iteration/N/D/L/solver/seg: one Levenberg-Marquardt iteration
 //   (linearisation + Schur linear solve), with its ratio to the BLAS-3 bound.
 // - BM_GramLowerBound/rows/D: a dense BLAS-3 Gram J^T J (Eigen SYRK).
-// - BM_FullSolve/N: the whole RunSlam, windowed, fixed iterations.
+// - BM_FullSolve/N/solver: the whole RunSlam, windowed, fixed iterations,
+//   with SPARSE_SCHUR or the default linear solver.
 // - BM_DefaultSolver/prior/poses/solver: the whole RunSlam with default
 //   options, the "auto" linear solver against each explicit one.
 // - BM_FeatureCache/N/D/cached: building the pose maps with and without the
@@ -13,7 +14,8 @@
 //   selected inverse of a sparse Cholesky.
 //
 // Flags of our own (removed before Google Benchmark parses the rest):
-//   --large      also register the N = 1e6 BM_Iteration rows
+//   --large      also register the N = 1e6 BM_Iteration rows and the
+//                whole solves at 125000 and 1e6 observations
 //   --solver_choice  register the BM_DefaultSolver rows
 //   --threads=K  Ceres threads (default 1: the BLAS-3 bound is one thread)
 //   --lm_iterations=K  LM iterations per BM_Iteration solve (default 3)
@@ -718,6 +720,7 @@ void QuickIterationRows(benchmark::internal::Benchmark* b) {
 
 void LargeIterationRows(benchmark::internal::Benchmark* b) {
   b->Args({1000000, 24, 20000, 1, 50})->Args({1000000, 24, 20000, 2, 50});
+  b->Args({1000000, 24, 20000, 3, 50});
 }
 
 void Configure(benchmark::internal::Benchmark* b) {
@@ -784,6 +787,14 @@ int main(int argc, char** argv) {
   if (large) {
     rff::Configure(RegisterBenchmark("BM_Iteration", rff::BM_Iteration)
                        ->Apply(rff::LargeIterationRows));
+    // Whole solves with the default linear solver at 1e6 observations and
+    // an eighth of that: memory and time(8N) / time(N).
+    RegisterBenchmark("BM_FullSolve", rff::BM_FullSolve)
+        ->ArgNames({"N", "solver"})
+        ->ArgsProduct({{125000, 1000000}, {1}})
+        ->UseRealTime()
+        ->Unit(benchmark::kMillisecond)
+        ->Iterations(1);
   }
   int count = static_cast<int>(args.size());
   benchmark::Initialize(&count, args.data());

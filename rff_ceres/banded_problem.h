@@ -54,10 +54,12 @@ struct BandedSize {
   std::int64_t entries = 0;
   double multiply_adds = 0.0;
   // Whether its factorisation costs at most kMaxEnvelopeWorkPerVariable
-  // multiply-adds per variable (envelope_cholesky.h).
+  // multiply-adds per variable, or kMaxSmallEnvelopeWork in all
+  // (envelope_cholesky.h).
   bool WorkWithinBound() const {
     return multiply_adds <=
-           kMaxEnvelopeWorkPerVariable * std::max(num_columns, 1);
+               kMaxEnvelopeWorkPerVariable * std::max(num_columns, 1) ||
+           multiply_adds <= kMaxSmallEnvelopeWork;
   }
 };
 

@@ -250,8 +250,9 @@ bool RunSolve(const SolverOptions& solver, ceres::Solver::Options ceres_options,
         // (envelope_cholesky.h).
         std::snprintf(text, sizeof(text),
                       "%.0f multiply-adds per variable in its factorisation, "
-                      "more than %.0f",
-                      work, kMaxEnvelopeWorkPerVariable);
+                      "more than %.0f, and %.3g in all, more than %.3g",
+                      work, kMaxEnvelopeWorkPerVariable, size.multiply_adds,
+                      kMaxSmallEnvelopeWork);
         why = text;
       }
     }

@@ -17,11 +17,18 @@ namespace rff {
 // Up to this many multiply-adds per variable in Factorize, an envelope
 // beats a fill-reducing sparse Cholesky on our systems of narrow states;
 // beyond it, landmarks seen again after long stretches fill the envelope
-// (whole WNOA solves against CHOLMOD: 0.8x at 220-944, 0.13x at 2794;
-// 1.27x at 3313, 2.7x at 13635; bench/README.md, "BANDED_CHOLESKY"). Feature
-// windows, whose J^T J the envelope forms a panel at a time, beat CHOLMOD
-// at any fill measured (0.25-0.7x at 9k-351k; bench/README.md).
-constexpr double kMaxEnvelopeWorkPerVariable = 3000.0;
+// (whole WNOA solves against CHOLMOD, 2026-11-28: 0.81x the time at 3313,
+// 0.64x at 4670 (the laser preset's 17 landmarks seen throughout); 1.10x at
+// 6361, 1.29x at 9623, 1.68x at 13635 (landmarks revisited);
+// bench/README.md, "BANDED_CHOLESKY"). Feature windows, whose J^T J the
+// envelope forms a panel at a time, beat CHOLMOD at any fill measured
+// (0.25-0.7x at 9k-351k; bench/README.md).
+constexpr double kMaxEnvelopeWorkPerVariable = 5000.0;
+// Up to this many multiply-adds in all, the envelope beats it whatever the
+// work per variable: CHOLMOD's analysis and per-step overhead outweigh the
+// fill it saves (paper presets of 300-2000 poses whose 50 landmarks are seen
+// throughout, 5000-5800 a variable, 1e7-7e7 in all: 0.33-0.5x the time).
+constexpr double kMaxSmallEnvelopeWork = 5e7;
 
 class EnvelopeMatrix {
  public:

@@ -53,8 +53,8 @@ std::vector<int> TimeOrderPositions(SlamProblem* problem,
 bool SchurFormFits(int t, Eigen::Index m);
 
 // Whether H is factorised in an envelope of `size` for solves: it fits the
-// memory of the dense forms and costs at most kMaxEnvelopeWorkPerVariable
-// per variable.
+// memory of the dense forms and its work is within the bound of
+// BandedSize::WorkWithinBound.
 bool EnvelopeAffordable(const BandedSize& size);
 
 // How a GaussNewtonSystem is factorised.
@@ -69,9 +69,8 @@ enum class Factorization {
   // Schur complement would cost t^3 / 3 for what a band does in O(t).
   kSparse,
   // An envelope Cholesky (envelope_cholesky.h) with the columns in a time
-  // order, where it costs at most kMaxEnvelopeWorkPerVariable per variable:
-  // no symbolic analysis and no fill outside the band (solves only); else
-  // kSparse.
+  // order, where EnvelopeAffordable: no symbolic analysis and no fill
+  // outside the band (solves only); else kSparse.
   kEnvelopeOrSparse,
 };
 

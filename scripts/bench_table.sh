@@ -6,8 +6,9 @@
 # BUILD_DIR defaults to ./build; it is configured (Release) if it has no
 # CMakeCache.txt, and rff_bench is (re)built. The default run takes a few
 # minutes on 2 cores; --large adds the N = 1e6 BM_Iteration rows
-# (SPARSE_SCHUR, ITERATIVE_SCHUR), each in a process of its own so that its
-# peak RSS is its own (a few minutes each). --solver_choice adds the
+# (SPARSE_SCHUR, ITERATIVE_SCHUR, BANDED_CHOLESKY) and whole solves with the
+# default linear solver at 125000 and 1e6 observations, each in a process of
+# its own so that its peak RSS is its own (a few minutes each). --solver_choice adds the
 # BM_DefaultSolver rows (default flags against each explicit linear solver,
 # 2k-1e5 poses), each in a process of its own under a 240 s timeout (30
 # rows: 30-40 minutes on 2 cores, at most 2 hours). Extra flags go to rff_bench, e.g. --threads=2 or
@@ -40,9 +41,14 @@ trap 'rm -rf "$out"' EXIT
 "$bench" --benchmark_out="$out/quick.json" --benchmark_out_format=json \
   ${extra[@]+"${extra[@]}"} >&2
 if [ "$large" = 1 ]; then
-  for solver in 1 2; do
+  for solver in 1 2 3; do
     "$bench" --large --benchmark_filter="BM_Iteration/N:1000000/.*/solver:$solver/" \
       --benchmark_out="$out/large$solver.json" --benchmark_out_format=json \
+      ${extra[@]+"${extra[@]}"} >&2
+  done
+  for n in 125000 1000000; do
+    "$bench" --large --benchmark_filter="BM_FullSolve/N:$n/" \
+      --benchmark_out="$out/full$n.json" --benchmark_out_format=json \
       ${extra[@]+"${extra[@]}"} >&2
   done
 fi
@@ -128,21 +134,24 @@ for r in rows:
           f"| {fmt(r['ratio_to_blas3'])} | {fmt(r['ratio_to_blas3_cpu'])} "
           f"| {fmt(r['peak_rss_MiB'])} |")
 
-full = {int(r["args"]["N"]): r for r in rows if r["bench"] == "BM_FullSolve"}
+full = {(r["args"]["solver"], int(r["args"]["N"])): r
+        for r in rows if r["bench"] == "BM_FullSolve"}
 if full:
-    print("\n### Full RunSlam, SPARSE_SCHUR, 10 LM steps (BM_FullSolve)\n")
-    print("| N | landmarks | total ms | Ceres ms | outside Ceres ms "
-          "| ms/iteration | time(N)/time(N/8) | Ceres(N)/Ceres(N/8) "
-          "| CPU(N)/CPU(N/8) | peak RSS MiB |")
-    print("| " + " | ".join(["---"] * 10) + " |")
-    for n in sorted(full):
-        r = full[n]
-        base = full.get(n // 8)
+    print("\n### Full RunSlam, 10 LM steps (BM_FullSolve)\n")
+    print("| N | landmarks | linear solver | total ms | mean ms | Ceres ms "
+          "| outside Ceres and mean ms | ms/iteration | time(N)/time(N/8) "
+          "| Ceres(N)/Ceres(N/8) | CPU(N)/CPU(N/8) | peak RSS MiB |")
+    print("| " + " | ".join(["---"] * 12) + " |")
+    for (solver, n) in sorted(full):
+        r = full[(solver, n)]
+        base = full.get((solver, n // 8))
         scale = fmt(ms(r) / ms(base)) if base else ""
         ceres = fmt(r["ceres_ms"] / base["ceres_ms"]) if base else ""
         cpu = fmt(r["cpu_time"] / base["cpu_time"]) if base else ""
-        print(f"| {n} | {int(r['landmarks'])} | {fmt(ms(r))} "
-              f"| {fmt(r['ceres_ms'])} | {fmt(r['outside_ceres_ms'])} "
+        name = ["SPARSE_SCHUR", "auto"][int(solver)]
+        print(f"| {n} | {int(r['landmarks'])} | {name} | {fmt(ms(r))} "
+              f"| {fmt(r['mean_ms'])} | {fmt(r['ceres_ms'])} "
+              f"| {fmt(r['outside_ceres_ms'])} "
               f"| {fmt(r['ms_per_iteration'])} | {scale} | {ceres} | {cpu} "
               f"| {fmt(r['peak_rss_MiB'])} |")
 

@@ -150,10 +150,11 @@ TEST(GaussNewtonSystemTest, EnvelopeInATimeOrderSolvesTheSameSystem) {
 }
 
 // Where the envelope would cost more than kMaxEnvelopeWorkPerVariable a
-// variable (every row over every column: n^2 / 6), or no time order is
-// given, the sparse LDLT solves.
+// variable (every row over every column: n^2 / 6) and more than
+// kMaxSmallEnvelopeWork in all (n^3 / 6), or no time order is given, the
+// sparse LDLT solves.
 TEST(GaussNewtonSystemTest, EnvelopeTooCostlyOrUnorderedFallsBackToSparse) {
-  const int n = 150;  // 3750 multiply-adds a variable.
+  const int n = 700;  // 81667 multiply-adds a variable, 5.7e7 in all.
   std::mt19937 rng(4);
   std::normal_distribution<double> normal;
   Eigen::MatrixXd dense(2 * n, n);
@@ -174,12 +175,15 @@ TEST(GaussNewtonSystemTest, EnvelopeTooCostlyOrUnorderedFallsBackToSparse) {
     EXPECT_LT((system->Solve(z) - expected).cwiseAbs().maxCoeff(),
               1e-9 * expected.cwiseAbs().maxCoeff());
   }
-  // At 20 columns (67 a variable) the same shape takes the envelope.
-  const RowMajorSparse small = dense.leftCols(20).sparseView();
-  const GaussNewtonSystem envelope(
-      small, 20, Factorization::kEnvelopeOrSparse, nullptr,
-      std::vector<int>(identity.begin(), identity.begin() + 20));
-  EXPECT_TRUE(envelope.envelope());
+  // At 20 columns (67 a variable) the same shape takes the envelope, and at
+  // 300 (15000 a variable, but 4.5e6 in all) too.
+  for (const int columns : {20, 300}) {
+    const RowMajorSparse small = dense.leftCols(columns).sparseView();
+    const GaussNewtonSystem envelope(
+        small, columns, Factorization::kEnvelopeOrSparse, nullptr,
+        std::vector<int>(identity.begin(), identity.begin() + columns));
+    EXPECT_TRUE(envelope.envelope()) << columns;
+  }
 }
 
 // A singular H (a column no row touches) fails the envelope's Cholesky;

@@ -324,20 +324,21 @@ TEST(PosteriorCovarianceTest, MatchesTheDenseInverseWithWindowedWeights) {
 }
 
 // Many wide feature windows (blocks past kMinPanelWidth, a factorisation
-// past kMaxEnvelopeWorkPerVariable) and no H kept from a solve: the
-// envelope, whose step is cheaper than the dense reduced system's, gives
-// what the selected inverse gives.
+// past both bounds of BandedSize::WorkWithinBound) and no H kept from a
+// solve: the envelope, whose step is cheaper than the dense reduced
+// system's, gives what the selected inverse gives.
 TEST(PosteriorCovarianceTest, ManyWideWindowsUseTheEnvelope) {
   WindowedRun run;
-  ASSERT_NO_FATAL_FAILURE(BuildWindowedRun(200, 40, 40, 40.0, 10.0, &run));
+  ASSERT_NO_FATAL_FAILURE(BuildWindowedRun(300, 60, 60, 40.0, 10.0, &run));
   const FeatureTrajectory& model = *run.model;
-  ASSERT_EQ(model.num_segments(), 5);
+  ASSERT_EQ(model.num_segments(), 8);
   std::vector<Landmark>& landmarks = run.landmarks;
   SlamProblem& problem = *run.problem;
   std::string error;
   const std::shared_ptr<BandedProblem> layout =
       problem.BandedLayout(problem.BandColumns());
-  ASSERT_FALSE(layout->Size().WorkWithinBound());
+  ASSERT_FALSE(layout->Size().WorkWithinBound())
+      << layout->Size().multiply_adds << " in " << layout->Size().num_columns;
   const StepWork work = EnvelopeAndDenseStepWork(&problem, *layout);
   ASSERT_LT(work.envelope, work.dense_reduced);
   std::vector<double> times;
