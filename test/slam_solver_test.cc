@@ -74,6 +74,24 @@ void EnvelopeSizeOf(const Dataset& dataset, const SlamOptions& options,
   *size = BandedProblem(*problem.problem(), problem.BandColumns()).Size();
 }
 
+// Auto solves `dataset` with BANDED_CHOLESKY, and the envelope takes
+// Ceres's steps: the same iterations, cost and poses to rounding.
+void ExpectAutoTakesTheEnvelopeWithCeresSteps(const Dataset& dataset,
+                                              SlamOptions options) {
+  options.solver.linear_solver = "auto";
+  SlamResult automatic;
+  std::string error;
+  ASSERT_TRUE(RunSlam(dataset, options, &automatic, &error)) << error;
+  EXPECT_EQ(automatic.linear_solver, "BANDED_CHOLESKY");
+  SlamResult banded, ceres_side;
+  ASSERT_TRUE(SolveWithBothCholeskys(dataset, options, &banded, &ceres_side));
+  EXPECT_EQ(banded.total_iterations, ceres_side.total_iterations);
+  EXPECT_GT(banded.total_iterations, 3);
+  EXPECT_NEAR(banded.summary.final_cost, ceres_side.summary.final_cost,
+              1e-9 * ceres_side.summary.final_cost);
+  EXPECT_LT(LargestPositionDifference(banded, ceres_side), 1e-9);
+}
+
 double ApeTranslation(const Dataset& dataset, const SlamResult& result) {
   Evaluation evaluation;
   std::string error;
@@ -178,19 +196,8 @@ TEST(SlamSolverTest, BandedCholeskyMatchesCeresSparseCholesky) {
   SlamOptions options;
   options.prior = "wnoa";
   options.learn_hyperparameters = "off";
-  SlamResult banded, ceres_side;
-  ASSERT_TRUE(SolveWithBothCholeskys(dataset, options, &banded, &ceres_side));
-  EXPECT_EQ(banded.linear_solver, "BANDED_CHOLESKY");
-  EXPECT_EQ(banded.total_iterations, ceres_side.total_iterations);
-  EXPECT_GT(banded.total_iterations, 3);
-  EXPECT_NEAR(banded.summary.final_cost, ceres_side.summary.final_cost,
-              1e-9 * ceres_side.summary.final_cost);
-  EXPECT_LT(LargestPositionDifference(banded, ceres_side), 1e-9);
   // Auto takes it where landmarks are few.
-  options.solver.linear_solver = "auto";
-  SlamResult automatic;
-  ASSERT_TRUE(RunSlam(dataset, options, &automatic, &error)) << error;
-  EXPECT_EQ(automatic.linear_solver, "BANDED_CHOLESKY");
+  ExpectAutoTakesTheEnvelopeWithCeresSteps(dataset, options);
 }
 
 // The paper's protocol (300 poses, 50 landmarks seen from the whole run):
@@ -206,17 +213,7 @@ TEST(SlamSolverTest, SmallSystemsTakeTheBandedCholeskyPastTheWorkPerVariable) {
   ASSERT_NO_FATAL_FAILURE(EnvelopeSizeOf(dataset, options, &size));
   EXPECT_GT(size.multiply_adds / size.num_columns, kMaxEnvelopeWorkPerVariable);
   EXPECT_LT(size.multiply_adds, kMaxSmallEnvelopeWork);
-  SlamResult automatic;
-  std::string error;
-  ASSERT_TRUE(RunSlam(dataset, options, &automatic, &error)) << error;
-  EXPECT_EQ(automatic.linear_solver, "BANDED_CHOLESKY");
-  SlamResult banded, ceres_side;
-  ASSERT_TRUE(SolveWithBothCholeskys(dataset, options, &banded, &ceres_side));
-  EXPECT_EQ(banded.total_iterations, ceres_side.total_iterations);
-  EXPECT_GT(banded.total_iterations, 3);
-  EXPECT_NEAR(banded.summary.final_cost, ceres_side.summary.final_cost,
-              1e-9 * ceres_side.summary.final_cost);
-  EXPECT_LT(LargestPositionDifference(banded, ceres_side), 1e-9);
+  ExpectAutoTakesTheEnvelopeWithCeresSteps(dataset, options);
 }
 
 // Feature windows take BANDED_CHOLESKY past the envelope's work rule for
@@ -227,10 +224,8 @@ TEST(SlamSolverTest, SmallSystemsTakeTheBandedCholeskyPastTheWorkPerVariable) {
 TEST(SlamSolverTest, FeatureWindowsTakeTheBandedCholeskyBeyondTheWorkRule) {
   Dataset dataset = PaperDataset(5, 1000, 60, 4);
   ASSERT_FALSE(dataset.ground_truth.empty());
-  std::string error;
   dataset.odometry.clear();
   SlamOptions options = testing::SyntheticRangeBearingOptions();
-  options.solver.linear_solver = "auto";
   options.features.segment_length = 30.0;  // 48 windows of 72 weights.
   options.features.segment_overlap = 9.0;
 
@@ -239,17 +234,7 @@ TEST(SlamSolverTest, FeatureWindowsTakeTheBandedCholeskyBeyondTheWorkRule) {
   ASSERT_NO_FATAL_FAILURE(EnvelopeSizeOf(dataset, options, &size));
   EXPECT_GT(size.num_columns, kMaxDenseReducedSystem);
   EXPECT_FALSE(size.WorkWithinBound());
-
-  SlamResult automatic;
-  ASSERT_TRUE(RunSlam(dataset, options, &automatic, &error)) << error;
-  EXPECT_EQ(automatic.linear_solver, "BANDED_CHOLESKY");
-  SlamResult banded, ceres_side;
-  ASSERT_TRUE(SolveWithBothCholeskys(dataset, options, &banded, &ceres_side));
-  EXPECT_EQ(banded.total_iterations, ceres_side.total_iterations);
-  EXPECT_GT(banded.total_iterations, 3);
-  EXPECT_NEAR(banded.summary.final_cost, ceres_side.summary.final_cost,
-              1e-9 * ceres_side.summary.final_cost);
-  EXPECT_LT(LargestPositionDifference(banded, ceres_side), 1e-9);
+  ExpectAutoTakesTheEnvelopeWithCeresSteps(dataset, options);
 }
 
 // What a problem's residuals depend on: each option below tells a problem
