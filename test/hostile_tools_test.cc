@@ -359,6 +359,9 @@ TEST(HostileToolAcceptTest, ObservationsFarApartInTimeSolve) {
             ValidDataset(0.0) + far + "GT_POSE 1800000 0 0 0\n");
   // Without odometry only the prior spans the gap, 1e17 m^2 wide: the
   // prior's scales cannot be learned in double precision, and it says so.
+  // The noise-free records leave the first round's tenfold step (the fixes
+  // of the initial trajectory are exact); the next round's Hessian is past
+  // double precision.
   std::string without_odometry;
   std::istringstream lines(ValidDataset(0.0));
   for (std::string line; std::getline(lines, line);) {
@@ -376,17 +379,19 @@ TEST(HostileToolAcceptTest, ObservationsFarApartInTimeSolve) {
           << file << " " << prior;
       if (file == "gap_without_odometry" && prior == "wnoa") {
         EXPECT_THAT(run.output,
-                    HasSubstr("warning: learning the scales stopped after 0 "
+                    HasSubstr("warning: learning the scales stopped after 1 "
                               "rounds: the Gauss-Newton Hessian is not "
                               "positive definite"));
-        // Nothing learned: the solve is finished as without learning.
-        const RunResult off = RunCommand(
-            Expand("{bin}/rff_slam --dataset={dir}/" + file +
-                       ".rffd --prior=wnoa --learn_hyperparameters=off "
-                       "--output_trajectory={dir}/off.tum",
-                   dir));
-        ASSERT_EQ(off.exit_code, 0) << off.output;
-        EXPECT_EQ(ReadFile(dir + "/out.tum"), ReadFile(dir + "/off.tum"));
+        // The solve is finished with the scales of the round that was
+        // learned, on the truth before the gap (x = t, y = 0).
+        std::vector<TimedPose> poses;
+        std::string error;
+        ASSERT_TRUE(ReadTum(dir + "/out.tum", &poses, &error)) << error;
+        ASSERT_EQ(poses.size(), 12u);
+        for (int k = 0; k <= 10; ++k) {
+          EXPECT_NEAR(poses[k].x, k, 2e-3) << k;
+          EXPECT_NEAR(poses[k].y, 0.0, 2e-3) << k;
+        }
       }
     }
   }

@@ -126,7 +126,11 @@ namespace {
 // the heading held): far beyond a turn, so the smoother ignores it.
 constexpr double kUnmeasuredHeadingVariance = 1e6;
 
-double Cost(const std::vector<MapResidualRow>& rows) {
+// The sum of squared whitened residuals of `observations` at `p`.
+double Cost(const std::vector<MapObservation>& observations,
+            const Eigen::Vector3d& p) {
+  std::vector<MapResidualRow> rows;
+  AppendMapResiduals(observations, p, &rows);
   double cost = 0.0;
   for (const MapResidualRow& r : rows) cost += r.residual * r.residual;
   return cost;
@@ -141,10 +145,9 @@ class PoseFit {
   using Scalar = double;
   enum { NUM_RESIDUALS = Eigen::Dynamic, NUM_PARAMETERS = kFree };
 
-  PoseFit(const std::vector<Observation>& observations,
-          const std::map<LandmarkId, KnownLandmark>& landmarks,
+  PoseFit(const std::vector<MapObservation>& observations,
           const Eigen::Vector3d& start)
-      : observations_(FindLandmarks(observations, landmarks)),
+      : observations_(observations),
         start_(start),
         num_rows_(MapRowCount(observations_)) {}
 
@@ -178,7 +181,7 @@ class PoseFit {
   }
 
  private:
-  const std::vector<MapObservation> observations_;
+  const std::vector<MapObservation>& observations_;
   const Eigen::Vector3d start_;
   const int num_rows_;
   mutable std::vector<MapResidualRow> rows_;  // Kept between steps.
@@ -189,10 +192,9 @@ class PoseFit {
 constexpr int kMaxRefineIterations = 50;
 
 template <int kFree>
-void RefineFree(const std::vector<Observation>& observations,
-                const std::map<LandmarkId, KnownLandmark>& landmarks,
+void RefineFree(const std::vector<MapObservation>& observations,
                 Eigen::Vector3d* pose) {
-  const PoseFit<kFree> fit(observations, landmarks, *pose);
+  const PoseFit<kFree> fit(observations, *pose);
   ceres::TinySolver<PoseFit<kFree>> solver;
   solver.options.max_num_iterations = kMaxRefineIterations;
   // Costs are chi-square sums of order the rows: stop at changes and steps
@@ -207,15 +209,14 @@ void RefineFree(const std::vector<Observation>& observations,
 // Levenberg-Marquardt (ceres::TinySolver) from `pose` over the free unknowns
 // (`free_heading` false holds theta). Returns the final cost (the sum of
 // squared whitened residuals) and leaves the pose in `pose`.
-double Refine(const std::vector<Observation>& observations,
-              const std::map<LandmarkId, KnownLandmark>& landmarks,
+double Refine(const std::vector<MapObservation>& observations,
               bool free_heading, Eigen::Vector3d* pose) {
   if (free_heading) {
-    RefineFree<3>(observations, landmarks, pose);
+    RefineFree<3>(observations, pose);
   } else {
-    RefineFree<2>(observations, landmarks, pose);
+    RefineFree<2>(observations, pose);
   }
-  return Cost(MapResiduals(observations, landmarks, *pose));
+  return Cost(observations, *pose);
 }
 
 }  // namespace
@@ -225,13 +226,13 @@ bool LocalizePose(const std::vector<Observation>& observations,
                   const std::vector<Eigen::Vector3d>& seeds,
                   const double* fixed_heading, double fixed_heading_sigma,
                   PoseFix* fix) {
-  std::vector<Observation> usable;
+  // The landmarks looked up once for every start's refinement.
+  const std::vector<MapObservation> usable =
+      FindLandmarks(observations, landmarks);
   int equations = 0, bearings = 0;
-  for (const Observation& o : observations) {
-    if (landmarks.count(o.id) == 0) continue;
-    usable.push_back(o);
-    equations += o.HasRange() + o.HasBearing();
-    bearings += o.HasBearing();
+  for (const MapObservation& m : usable) {
+    equations += m.observation->HasRange() + m.observation->HasBearing();
+    bearings += m.observation->HasBearing();
   }
   if (usable.empty() || seeds.empty()) return false;
   const bool free_heading = bearings > 0 && fixed_heading == nullptr;
@@ -247,7 +248,7 @@ bool LocalizePose(const std::vector<Observation>& observations,
   double lowest = std::numeric_limits<double>::infinity();
   for (Eigen::Vector3d pose : seeds) {
     if (fixed_heading != nullptr) pose.z() = *fixed_heading;
-    const double cost = Refine(usable, landmarks, free_heading, &pose);
+    const double cost = Refine(usable, free_heading, &pose);
     if (!std::isfinite(cost) || !pose.allFinite()) continue;
     minima.emplace_back(cost, pose);
     lowest = std::min(lowest, cost);
@@ -271,7 +272,9 @@ bool LocalizePose(const std::vector<Observation>& observations,
   // Information of the free unknowns; a degenerate geometry (collinear
   // landmarks, parallel bearings) leaves it singular.
   Eigen::Matrix3d h = Eigen::Matrix3d::Zero();
-  for (const MapResidualRow& r : MapResiduals(usable, landmarks, best)) {
+  std::vector<MapResidualRow> rows;
+  AppendMapResiduals(usable, best, &rows);
+  for (const MapResidualRow& r : rows) {
     h += r.jacobian.transpose() * r.jacobian;
   }
   const Eigen::MatrixXd hn = h.topLeftCorner(unknowns, unknowns);
@@ -406,25 +409,25 @@ std::vector<Eigen::Vector3d> Seeds(
   std::vector<Eigen::Vector3d> seeds = {prediction};
   bool bearings = false;
   for (const Observation& o : observations) bearings |= o.HasBearing();
+  std::vector<MapObservation> range_bearings;
+  for (const MapObservation& m : FindLandmarks(observations, landmarks)) {
+    if (m.observation->HasRange() && m.observation->HasBearing()) {
+      range_bearings.push_back(m);
+    }
+  }
   for (int k = 0; k < 8; ++k) {
     Eigen::Vector3d seed = prediction;
     seed.z() += k * M_PI / 4.0;
     if (bearings && k > 0) seeds.push_back(seed);
+    if (range_bearings.empty()) continue;
     Eigen::Vector2d sum = Eigen::Vector2d::Zero();
-    int count = 0;
-    for (const Observation& o : observations) {
-      if (!o.HasRange() || !o.HasBearing() || !landmarks.count(o.id)) {
-        continue;
-      }
-      const double angle = seed.z() + o.bearing;
-      sum += landmarks.at(o.id).position -
-             o.range * Eigen::Vector2d(std::cos(angle), std::sin(angle));
-      ++count;
+    for (const auto& [o, l] : range_bearings) {
+      const double angle = seed.z() + o->bearing;
+      sum += l->position -
+             o->range * Eigen::Vector2d(std::cos(angle), std::sin(angle));
     }
-    if (count > 0) {
-      seed.head<2>() = sum / count;
-      seeds.push_back(seed);
-    }
+    seed.head<2>() = sum / static_cast<double>(range_bearings.size());
+    seeds.push_back(seed);
   }
   return seeds;
 }
