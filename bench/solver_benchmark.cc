@@ -702,6 +702,8 @@ void BM_PosteriorCovariance(benchmark::State& state) {
 }
 
 // Rows: {N, D, L, solver (0 dense, 1 sparse, 2 iterative), segment seconds}.
+// Solver index: 0 DENSE_SCHUR, 1 SPARSE_SCHUR, 2 ITERATIVE_SCHUR, 3
+// BANDED_CHOLESKY (kSolverNames).
 void QuickIterationRows(benchmark::internal::Benchmark* b) {
   // N scaling at the config settings (D = 24, windows 50 s / 15 s, L = N/50).
   b->Args({1000, 24, 20, 0, 50})->Args({1000, 24, 20, 1, 50});

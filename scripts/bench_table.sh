@@ -8,10 +8,11 @@
 # minutes on 2 cores; --large adds the N = 1e6 BM_Iteration rows
 # (SPARSE_SCHUR, ITERATIVE_SCHUR, BANDED_CHOLESKY) and whole solves with the
 # default linear solver at 125000 and 1e6 observations, each in a process of
-# its own so that its peak RSS is its own (a few minutes each). --solver_choice adds the
-# BM_DefaultSolver rows (default flags against each explicit linear solver,
-# 2k-1e5 poses), each in a process of its own under a 240 s timeout (30
-# rows: 30-40 minutes on 2 cores, at most 2 hours). Extra flags go to rff_bench, e.g. --threads=2 or
+# its own so that its peak RSS is its own (a few minutes each).
+# --solver_choice adds the BM_DefaultSolver rows (default flags against each
+# explicit linear solver, 2k-1e5 poses), each in a process of its own under
+# a 240 s timeout (30 rows: 30-40 minutes on 2 cores, at most 2 hours).
+# Extra flags go to rff_bench, e.g. --threads=2 or
 # --benchmark_repetitions=3 (the tables then use the medians).
 set -euo pipefail
 repo=$(cd "$(dirname "$0")/.." && pwd)
@@ -41,15 +42,22 @@ trap 'rm -rf "$out"' EXIT
 "$bench" --benchmark_out="$out/quick.json" --benchmark_out_format=json \
   ${extra[@]+"${extra[@]}"} >&2
 if [ "$large" = 1 ]; then
+  # A row that fails (out of memory, say) is reported; the others stay.
+  large_row() {
+    local filter=$1 json=$2 status=0
+    "$bench" --large --benchmark_filter="$filter" --benchmark_out="$json" \
+      --benchmark_out_format=json ${extra[@]+"${extra[@]}"} >&2 || status=$?
+    if [ $status != 0 ]; then
+      printf '{"benchmarks": [{"name": "%s", "run_name": "%s", "error_occurred": true, "error_message": "exit %s"}]}\n' \
+        "$filter" "$filter" "$status" > "$json"
+    fi
+  }
   for solver in 1 2 3; do
-    "$bench" --large --benchmark_filter="BM_Iteration/N:1000000/.*/solver:$solver/" \
-      --benchmark_out="$out/large$solver.json" --benchmark_out_format=json \
-      ${extra[@]+"${extra[@]}"} >&2
+    large_row "BM_Iteration/N:1000000/.*/solver:$solver/" \
+      "$out/large$solver.json"
   done
   for n in 125000 1000000; do
-    "$bench" --large --benchmark_filter="BM_FullSolve/N:$n/" \
-      --benchmark_out="$out/full$n.json" --benchmark_out_format=json \
-      ${extra[@]+"${extra[@]}"} >&2
+    large_row "BM_FullSolve/N:$n/" "$out/full$n.json"
   done
 fi
 

@@ -85,6 +85,7 @@ void ExpectAutoTakesTheEnvelopeWithCeresSteps(const Dataset& dataset,
   EXPECT_EQ(automatic.linear_solver, "BANDED_CHOLESKY");
   SlamResult banded, ceres_side;
   ASSERT_TRUE(SolveWithBothCholeskys(dataset, options, &banded, &ceres_side));
+  EXPECT_EQ(banded.linear_solver, "BANDED_CHOLESKY");
   EXPECT_EQ(banded.total_iterations, ceres_side.total_iterations);
   EXPECT_GT(banded.total_iterations, 3);
   EXPECT_NEAR(banded.summary.final_cost, ceres_side.summary.final_cost,

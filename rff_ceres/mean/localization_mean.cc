@@ -83,7 +83,7 @@ void AppendMapResiduals(const std::vector<MapObservation>& observations,
           std::sqrt(o.sigma_range * o.sigma_range + l.sigma * l.sigma);
       MapResidualRow row;
       row.residual = (range - o.range) / sigma;
-      row.jacobian = d_range.transpose() / sigma;
+      row.jacobian = row.measurement_jacobian = d_range.transpose() / sigma;
       rows->push_back(row);
     }
     double bearing;
@@ -96,7 +96,7 @@ void AppendMapResiduals(const std::vector<MapObservation>& observations,
       const double sigma =
           std::sqrt(o.sigma_bearing * o.sigma_bearing + spread * spread);
       row.residual = WrapAngle(bearing - o.bearing) / sigma;
-      row.jacobian = d_bearing.transpose() / sigma;
+      row.jacobian = row.measurement_jacobian = d_bearing.transpose() / sigma;
       // The sigma moves with the range: d(w / sigma) adds
       // (w / sigma) (s / r)^2 / (sigma^2 r) dr. Left out, Gauss-Newton stops
       // short of the minimum wherever the spread dominates the sigma.
@@ -275,7 +275,7 @@ bool LocalizePose(const std::vector<Observation>& observations,
   std::vector<MapResidualRow> rows;
   AppendMapResiduals(usable, best, &rows);
   for (const MapResidualRow& r : rows) {
-    h += r.jacobian.transpose() * r.jacobian;
+    h += r.measurement_jacobian.transpose() * r.measurement_jacobian;
   }
   const Eigen::MatrixXd hn = h.topLeftCorner(unknowns, unknowns);
   Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(hn);

@@ -25,11 +25,15 @@ struct KnownLandmark {
   double sigma = 0.0;
 };
 
-// One whitened residual row of an observation against a known landmark, and
-// its derivative by the unknowns (x, y, theta).
+// One whitened residual row of an observation against a known landmark over
+// the unknowns (x, y, theta).
 struct MapResidualRow {
   double residual = 0.0;
+  // The residual's derivative: a bearing's sigma moves with the range.
   Eigen::RowVector3d jacobian = Eigen::RowVector3d::Zero();
+  // The measurement's derivative over its sigma held: the fix's information
+  // (Fisher's, which does not grow with the residual).
+  Eigen::RowVector3d measurement_jacobian = Eigen::RowVector3d::Zero();
 };
 
 // Whitened residuals of `observations` (landmarks missing from `landmarks`
@@ -58,7 +62,8 @@ struct PoseFix {
 // Localises the robot at one time from `observations` (all at that time) of
 // landmarks in `landmarks` (others are ignored): Gauss-Newton on
 // (x, y, theta), or (x, y) for range-only, started from every pose in
-// `seeds`, keeping the lowest cost. The landmark sigma is added to the
+// `seeds`; among the minima within chi^2 4 of the lowest, the one nearest
+// the first seed. The landmark sigma is added to the
 // measurement noise (sigma_r^2 + s^2; sigma_b^2 + (s / r)^2). With
 // `fixed_heading` (range-bearing from one landmark) the heading is held at
 // that value, and its uncertainty `fixed_heading_sigma` is carried into the

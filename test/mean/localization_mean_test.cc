@@ -161,6 +161,9 @@ double MapCost(const WideMapScene& scene, const Eigen::Vector3d& p) {
   return cost;
 }
 
+// The Jacobian is the residual's derivative; the measurement's (the fix's
+// information) holds the sigma, so it differs only on bearings, only in
+// position (the spread moves with the range) and by the residual's share.
 TEST(MapResidualsTest, JacobianIsTheResidualsDerivative) {
   const WideMapScene scene = MakeWideMapScene();
   constexpr double kStep = 1e-6;
@@ -170,6 +173,16 @@ TEST(MapResidualsTest, JacobianIsTheResidualsDerivative) {
     const std::vector<MapResidualRow> rows =
         MapResiduals(scene.observations, scene.landmarks, p);
     ASSERT_EQ(rows.size(), 8u);
+    for (std::size_t r = 0; r < rows.size(); ++r) {
+      const Eigen::RowVector3d spread_term =
+          rows[r].jacobian - rows[r].measurement_jacobian;
+      if (r % 2 == 0) {  // Range: a sigma of its own.
+        EXPECT_EQ(spread_term, Eigen::RowVector3d::Zero()) << r;
+      } else {
+        EXPECT_EQ(spread_term(2), 0.0) << r;
+        EXPECT_GT(spread_term.norm(), 0.0) << r;
+      }
+    }
     for (int c = 0; c < 3; ++c) {
       Eigen::Vector3d step = Eigen::Vector3d::Zero();
       step[c] = kStep;
