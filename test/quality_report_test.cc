@@ -236,7 +236,7 @@ TEST(QualityReportTest, SolveOfContradictoryOdometryIsSuspect) {
       << error;
   EXPECT_EQ(bad.quality.verdict, "suspect");
   EXPECT_THAT(QualityLine(bad.quality),
-              HasSubstr("odometry 42.6% beyond 3 sigma > 5%"));
+              HasSubstr("odometry 40.3% beyond 3 sigma > 5%"));
 }
 
 // Range self-calibration stays physical on data it cannot explain: the scale
