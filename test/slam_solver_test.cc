@@ -217,6 +217,33 @@ TEST(SlamSolverTest, SmallSystemsTakeTheBandedCholeskyPastTheWorkPerVariable) {
   ExpectAutoTakesTheEnvelopeWithCeresSteps(dataset, options);
 }
 
+// Landmarks revisited after long stretches (a 3000-pose random walk among
+// 150 landmarks seen within 15 m) fill the envelope past both bounds: auto
+// solves WNOA states with CHOLMOD and says why.
+TEST(SlamSolverTest, RevisitedLandmarksPastBothBoundsTakeCholmod) {
+  SimulationOptions sim = PaperOptions(3);
+  sim.num_steps = 3000;
+  sim.num_landmarks = 150;
+  sim.sensor_range = 15.0;
+  sim.observe_nearest = true;
+  sim.observations_per_step = 6;
+  sim.odometry = true;
+  Dataset dataset;
+  std::string error;
+  ASSERT_TRUE(Simulate(sim, &dataset, &error)) << error;
+  SlamOptions options;
+  options.prior = "wnoa";
+  options.learn_hyperparameters = "off";
+  options.solver.max_iterations = 1;
+  SlamResult result;
+  ASSERT_TRUE(RunSlam(dataset, options, &result, &error)) << error;
+  EXPECT_EQ(result.linear_solver, "SPARSE_NORMAL_CHOLESKY");
+  EXPECT_THAT(result.linear_solver_reason,
+              HasSubstr("(not BANDED_CHOLESKY: 13635 multiply-adds per "
+                        "variable in its factorisation, more than 5000, and "
+                        "2.5e+08 in all, more than 5e+07)"));
+}
+
 // Feature windows take BANDED_CHOLESKY past the envelope's work rule for
 // narrow states (60 landmarks seen all along a 1000 s run fill their rows:
 // 24633 multiply-adds a variable over 2568 columns, 6.3e7 in all): a
