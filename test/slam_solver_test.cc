@@ -55,6 +55,15 @@ SlamOptions PaperSolverOptions() {
   return ::testing::AssertionSuccess();
 }
 
+// WNOA with its scales as stated: one solve, so that no learning round
+// amplifies the last bits.
+SlamOptions WnoaWithoutLearning() {
+  SlamOptions options;
+  options.prior = "wnoa";
+  options.learn_hyperparameters = "off";
+  return options;
+}
+
 // The envelope of the problem RunSlam builds first for `dataset`.
 void EnvelopeSizeOf(const Dataset& dataset, const SlamOptions& options,
                     BandedSize* size) {
@@ -194,9 +203,7 @@ TEST(SlamSolverTest, BandedCholeskyMatchesCeresSparseCholesky) {
   Dataset dataset;
   std::string error;
   ASSERT_TRUE(Simulate(sim, &dataset, &error)) << error;
-  SlamOptions options;
-  options.prior = "wnoa";
-  options.learn_hyperparameters = "off";
+  SlamOptions options = WnoaWithoutLearning();
   // Auto takes it where landmarks are few.
   ExpectAutoTakesTheEnvelopeWithCeresSteps(dataset, options);
 }
@@ -207,9 +214,7 @@ TEST(SlamSolverTest, BandedCholeskyMatchesCeresSparseCholesky) {
 // envelope, which takes Ceres's steps.
 TEST(SlamSolverTest, SmallSystemsTakeTheBandedCholeskyPastTheWorkPerVariable) {
   const Dataset dataset = PaperDataset(23, 300, 50, 4);
-  SlamOptions options;
-  options.prior = "wnoa";
-  options.learn_hyperparameters = "off";
+  SlamOptions options = WnoaWithoutLearning();
   BandedSize size;
   ASSERT_NO_FATAL_FAILURE(EnvelopeSizeOf(dataset, options, &size));
   EXPECT_GT(size.multiply_adds / size.num_columns, kMaxEnvelopeWorkPerVariable);
@@ -231,9 +236,7 @@ TEST(SlamSolverTest, RevisitedLandmarksPastBothBoundsTakeCholmod) {
   Dataset dataset;
   std::string error;
   ASSERT_TRUE(Simulate(sim, &dataset, &error)) << error;
-  SlamOptions options;
-  options.prior = "wnoa";
-  options.learn_hyperparameters = "off";
+  SlamOptions options = WnoaWithoutLearning();
   options.solver.max_iterations = 1;
   SlamResult result;
   ASSERT_TRUE(RunSlam(dataset, options, &result, &error)) << error;
@@ -949,9 +952,7 @@ TEST(SlamSolverTest, IncrementalBandedCholeskyMatchesCeres) {
   Dataset dataset;
   std::string error;
   ASSERT_TRUE(Simulate(sim, &dataset, &error)) << error;
-  SlamOptions options;
-  options.prior = "wnoa";
-  options.learn_hyperparameters = "off";
+  SlamOptions options = WnoaWithoutLearning();
   options.incremental.every = 40;
   options.incremental.lag = 15.0;
   SlamResult banded, ceres_side;
