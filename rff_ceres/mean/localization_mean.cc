@@ -65,6 +65,21 @@ int MapRowCount(const std::vector<MapObservation>& observations) {
   return rows;
 }
 
+// The measured values among `observations` (equations for the unknowns)
+// and the bearings among them.
+struct MeasuredValues {
+  int equations = 0, bearings = 0;
+};
+MeasuredValues CountMeasuredValues(
+    const std::vector<MapObservation>& observations) {
+  MeasuredValues count;
+  for (const MapObservation& m : observations) {
+    count.equations += m.observation->HasRange() + m.observation->HasBearing();
+    count.bearings += m.observation->HasBearing();
+  }
+  return count;
+}
+
 // MapResiduals' rows of `observations` at `p`, into `rows`.
 void AppendMapResiduals(const std::vector<MapObservation>& observations,
                         const Eigen::Vector3d& p,
@@ -219,21 +234,13 @@ double Refine(const std::vector<MapObservation>& observations,
   return Cost(observations, *pose);
 }
 
-}  // namespace
-
-bool LocalizePose(const std::vector<Observation>& observations,
-                  const std::map<LandmarkId, KnownLandmark>& landmarks,
-                  const std::vector<Eigen::Vector3d>& seeds,
-                  const double* fixed_heading, double fixed_heading_sigma,
-                  PoseFix* fix) {
-  // The landmarks looked up once for every start's refinement.
-  const std::vector<MapObservation> usable =
-      FindLandmarks(observations, landmarks);
-  int equations = 0, bearings = 0;
-  for (const MapObservation& m : usable) {
-    equations += m.observation->HasRange() + m.observation->HasBearing();
-    bearings += m.observation->HasBearing();
-  }
+// LocalizePose on the observations whose landmarks are found: looked up
+// once for every start's refinement.
+bool LocalizeAgainst(const std::vector<MapObservation>& usable,
+                     const std::vector<Eigen::Vector3d>& seeds,
+                     const double* fixed_heading, double fixed_heading_sigma,
+                     PoseFix* fix) {
+  const auto [equations, bearings] = CountMeasuredValues(usable);
   if (usable.empty() || seeds.empty()) return false;
   const bool free_heading = bearings > 0 && fixed_heading == nullptr;
   const int unknowns = free_heading ? 3 : 2;
@@ -302,6 +309,17 @@ bool LocalizePose(const std::vector<Observation>& observations,
   fix->chi2 = best_cost;
   fix->dof = equations - unknowns;
   return true;
+}
+
+}  // namespace
+
+bool LocalizePose(const std::vector<Observation>& observations,
+                  const std::map<LandmarkId, KnownLandmark>& landmarks,
+                  const std::vector<Eigen::Vector3d>& seeds,
+                  const double* fixed_heading, double fixed_heading_sigma,
+                  PoseFix* fix) {
+  return LocalizeAgainst(FindLandmarks(observations, landmarks), seeds,
+                         fixed_heading, fixed_heading_sigma, fix);
 }
 
 namespace {
@@ -401,16 +419,16 @@ std::vector<Point> Points(const Dataset& dataset,
 
 // Seeds for one time: the prediction, and for measurements with bearings
 // the prediction turned by multiples of 45 degrees, each also moved to where
-// the range-bearing measurements put it under that heading.
-std::vector<Eigen::Vector3d> Seeds(
-    const std::vector<Observation>& observations,
-    const std::map<LandmarkId, KnownLandmark>& landmarks,
-    const Eigen::Vector3d& prediction) {
+// the range-bearing measurements of landmarks found (`usable`) put it under
+// that heading.
+std::vector<Eigen::Vector3d> Seeds(const std::vector<Observation>& observations,
+                                   const std::vector<MapObservation>& usable,
+                                   const Eigen::Vector3d& prediction) {
   std::vector<Eigen::Vector3d> seeds = {prediction};
   bool bearings = false;
   for (const Observation& o : observations) bearings |= o.HasBearing();
   std::vector<MapObservation> range_bearings;
-  for (const MapObservation& m : FindLandmarks(observations, landmarks)) {
+  for (const MapObservation& m : usable) {
     if (m.observation->HasRange() && m.observation->HasBearing()) {
       range_bearings.push_back(m);
     }
@@ -517,19 +535,15 @@ std::shared_ptr<const MeanFunction> BuildLocalizationMean(
     ++report->times;
 
     const Eigen::Vector3d prediction = base(t) + state;
-    int equations = 0, bearings = 0;
-    for (const Observation& o : at) {
-      if (!landmarks.count(o.id)) continue;
-      equations += o.HasRange() + o.HasBearing();
-      bearings += o.HasBearing();
-    }
+    const std::vector<MapObservation> usable = FindLandmarks(at, landmarks);
+    const auto [equations, bearings] = CountMeasuredValues(usable);
     // Too few equations for (x, y, theta): hold the predicted heading.
     const bool hold_heading = bearings > 0 && equations < 3;
     const double heading = prediction.z();
     PoseFix fix;
-    if (!LocalizePose(at, landmarks, Seeds(at, landmarks, prediction),
-                      hold_heading ? &heading : nullptr,
-                      options.held_heading_sigma, &fix)) {
+    if (!LocalizeAgainst(usable, Seeds(at, usable, prediction),
+                         hold_heading ? &heading : nullptr,
+                         options.held_heading_sigma, &fix)) {
       continue;
     }
     fix.pose.t = t;
