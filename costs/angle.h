@@ -8,8 +8,10 @@
 namespace rff {
 
 // Wraps an angle to (-pi, pi]: residuals on the circle are measured along
-// the shortest arc. remainder() maps to [-pi, pi]; -pi folds onto pi.
+// the shortest arc. remainder() maps to [-pi, pi]; -pi folds onto pi. An
+// angle already in (-pi, pi] is its own remainder, bit for bit, and most are.
 inline double WrapAngle(double angle) {
+  if (angle > -M_PI && angle <= M_PI) return angle;
   double wrapped = std::remainder(angle, 2.0 * M_PI);
   if (wrapped <= -M_PI) wrapped += 2.0 * M_PI;
   return wrapped;

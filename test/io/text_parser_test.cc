@@ -94,6 +94,15 @@ TEST(TextParserTest, WrapsAnglesToHalfOpenInterval) {
   EXPECT_NEAR(WrapAngle(3.0 * M_PI / 2.0), -M_PI / 2.0, 1e-15);
   EXPECT_NEAR(WrapAngle(-7.0), -7.0 + 2.0 * M_PI, 1e-15);
   EXPECT_DOUBLE_EQ(WrapAngle(0.25), 0.25);
+  // The in-range shortcut returns what remainder() does, bit for bit.
+  for (const double a :
+       {std::nextafter(-M_PI, 0.0), -1e-300, 0.0, 3.0,
+        std::nextafter(M_PI, 0.0), M_PI, std::nextafter(M_PI, 4.0),
+        std::nextafter(-M_PI, -4.0)}) {
+    double expected = std::remainder(a, 2.0 * M_PI);
+    if (expected <= -M_PI) expected += 2.0 * M_PI;
+    EXPECT_EQ(WrapAngle(a), expected) << a;
+  }
 }
 
 TEST(TextParserTest, FormatNumberRoundTrips) {
