@@ -434,6 +434,44 @@ std::map<std::string, std::vector<double>> SlamProblem::WhitenedResidualsByKind(
   return by_kind;
 }
 
+std::map<VarianceGroup, std::map<LandmarkId, std::vector<double>>>
+SlamProblem::ObservationResidualSeries() {
+  // (time, residual) per value and landmark.
+  std::map<VarianceGroup,
+           std::map<LandmarkId, std::vector<std::pair<double, double>>>>
+      timed;
+  std::vector<double> residuals;
+  for (const auto& [id, source] : sources_) {
+    const VarianceGroup first = source.first_row;
+    if (!source.has_landmark || !source.has_time ||
+        (first != VarianceGroup::kRange && first != VarianceGroup::kBearing)) {
+      continue;
+    }
+    residuals.assign(
+        problem_->GetCostFunctionForResidualBlock(id)->num_residuals(), 0.0);
+    double cost = 0.0;
+    if (!problem_->EvaluateResidualBlock(id, /*apply_loss_function=*/false,
+                                         &cost, residuals.data(), nullptr)) {
+      continue;
+    }
+    for (std::size_t row = 0; row < residuals.size(); ++row) {
+      timed[source.RowGroup(static_cast<int>(row))][source.landmark]
+          .emplace_back(source.t0, residuals[row]);
+    }
+  }
+  std::map<VarianceGroup, std::map<LandmarkId, std::vector<double>>> series;
+  for (auto& [group, by_landmark] : timed) {
+    for (auto& [landmark, values] : by_landmark) {
+      // By time, and a landmark seen twice at one time by value: the
+      // blocks come in no fixed order.
+      std::sort(values.begin(), values.end());
+      std::vector<double>& out = series[group][landmark];
+      for (const auto& [t, r] : values) out.push_back(r);
+    }
+  }
+  return series;
+}
+
 bool SlamProblem::FindNonFinite(std::string* description) {
   std::vector<ceres::ResidualBlockId> ids;
   problem_->GetResidualBlocks(&ids);

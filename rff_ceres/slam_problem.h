@@ -223,6 +223,11 @@ class SlamProblem {
   // noise-scaled ones the problem is solved with.
   std::map<std::string, std::vector<double>> WhitenedResidualsByKind(
       bool stated_sigmas = false);
+  // The whitened residuals (without the robust loss) of each landmark's
+  // observations in time order, per sensor value (kRange, kBearing; a
+  // range-bearing row goes to each).
+  std::map<VarianceGroup, std::map<LandmarkId, std::vector<double>>>
+  ObservationResidualSeries();
   bool CheckLandmarksDetermined(double max_condition, std::string* error);
   // The variance group of every row of the residual blocks `ids`, in order.
   std::vector<VarianceGroup> RowGroups(

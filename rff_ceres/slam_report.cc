@@ -39,6 +39,20 @@ std::string JsonStringArray(const std::vector<std::string>& items) {
   return out + "]";
 }
 
+// [{"kind": "range", "batches": 271, "ratio": 9.7, "drifts": true}, ...]
+std::string DriftJson(const std::vector<ResidualDrift>& drifts) {
+  std::string out = "[";
+  for (std::size_t i = 0; i < drifts.size(); ++i) {
+    const ResidualDrift& d = drifts[i];
+    out += std::string(i == 0 ? "" : ", ") +
+           "{\"kind\": " + JsonString(d.kind) +
+           ", \"batches\": " + std::to_string(d.batches) +
+           ", \"ratio\": " + FormatNumber(d.ratio) +
+           ", \"drifts\": " + (d.drifts ? "true" : "false") + "}";
+  }
+  return out + "]";
+}
+
 }  // namespace
 
 void PrintSlamSummary(const SlamOptions& options, const SlamResult& result,
@@ -73,6 +87,14 @@ void PrintSlamSummary(const SlamOptions& options, const SlamResult& result,
   if (!result.covariance_truncation.empty()) {
     *out << "  covariance   the basis's truncation term: "
          << result.covariance_truncation << "\n";
+  }
+  for (const ResidualDrift& drift : result.residual_drift) {
+    if (!drift.drifts) continue;
+    *out << "  covariance   optimistic: the " << drift.kind
+         << " residuals drift together, their sums over " << kDriftBatch
+         << " sightings of a landmark varying " << drift.ratio
+         << " times as much as white errors' (the covariances assume white "
+            "errors)\n";
   }
   if (!result.noise_learned.empty()) {
     *out << "  noise        sigmas learned as the stated ones times:";
@@ -199,6 +221,7 @@ void WriteSummaryJson(const SlamOptions& options, const SlamResult& result,
       << ",\n"
       << "  \"covariance_truncation\": "
       << JsonString(result.covariance_truncation) << ",\n"
+      << "  \"residual_drift\": " << DriftJson(result.residual_drift) << ",\n"
       << "  \"noise_scales_kept\": " << JsonStringArray(result.noise_kept)
       << ",\n"
       << "  \"noise_scales_learned\": " << JsonStringArray(result.noise_learned)

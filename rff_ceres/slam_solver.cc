@@ -243,6 +243,10 @@ bool ReportSolution(const Dataset& dataset, const SlamOptions& options,
                               &result->covariance_truncation);
     }
     if (!AddMeanCovariance(wnoa_mean_solve, result, error)) return false;
+    for (const auto& [group, series] : problem->ObservationResidualSeries()) {
+      result->residual_drift.push_back(
+          MeasureResidualDrift(VarianceGroupName(group), series));
+    }
   }
   return true;
 }

@@ -19,6 +19,7 @@
 #include "rff_ceres/initialization.h"
 #include "rff_ceres/options.h"
 #include "rff_ceres/quality_report.h"
+#include "rff_ceres/residual_drift.h"
 #include "rff_ceres/slam_problem.h"
 #include "rff_ceres/types.h"
 #include "rff_ceres/wnoa_trajectory.h"
@@ -45,6 +46,10 @@ struct SlamResult {
   // What the feature basis's truncation added to them
   // (truncation_covariance.h), or why nothing.
   std::string covariance_truncation;
+  // With output.covariance: whether each sensor value's residuals drift
+  // together over a landmark's sightings (residual_drift.h), which the
+  // covariances, computed for white errors, do not count.
+  std::vector<ResidualDrift> residual_drift;
   ceres::Solver::Summary summary;          // Of the last solve.
   int total_iterations = 0;                // Over all outer rounds.
   double solve_seconds = 0.0;              // Wall time of the whole RunSlam.
