@@ -187,6 +187,16 @@ def test_result_arrays(solved):
     assert "60 poses" in repr(solved)
 
 
+def test_residual_drift_comes_with_the_covariance(solved, plain):
+    # White simulated errors: each value judged, none drifting.
+    drift = solved.summary["residual_drift"]
+    assert sorted(d["kind"] for d in drift) == ["bearing", "range"]
+    for d in drift:
+        assert d["batches"] > 0 and math.isfinite(d["ratio"])
+        assert d["drifts"] is False
+    assert plain.summary["residual_drift"] == []
+
+
 def test_pose_at_the_solves_times_is_its_poses(solved):
     np.testing.assert_array_equal(solved.pose_at(solved.times), solved.poses)
     for i in (0, 17, len(solved.times) - 1):
