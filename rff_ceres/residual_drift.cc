@@ -2,29 +2,30 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
+
+#include "rff_ceres/statistics.h"
 
 namespace rff {
 
 ResidualDrift MeasureResidualDrift(
     const std::string& kind,
-    const std::map<LandmarkId, std::vector<double>>& series, int batch) {
+    const std::map<LandmarkId, std::vector<double>>& series) {
+  constexpr std::size_t batch = kDriftBatch;
   ResidualDrift drift;
   drift.kind = kind;
   std::vector<double> magnitudes;
   for (const auto& [landmark, values] : series) {
     for (const double r : values) magnitudes.push_back(std::abs(r));
   }
-  if (magnitudes.empty() || batch < 1) return drift;
-  const auto middle = magnitudes.begin() + magnitudes.size() / 2;
-  std::nth_element(magnitudes.begin(), middle, magnitudes.end());
-  const double level = 5.0 * 1.4826 * *middle;
+  const double clip_level = 5.0 * 1.4826 * Median(std::move(magnitudes));
   double batch_squares = 0.0, squares = 0.0;
   for (const auto& [landmark, values] : series) {
     const std::size_t whole = values.size() / batch;
     for (std::size_t b = 0; b < whole; ++b) {
       double sum = 0.0;
       for (std::size_t i = b * batch; i < (b + 1) * batch; ++i) {
-        const double r = std::clamp(values[i], -level, level);
+        const double r = std::clamp(values[i], -clip_level, clip_level);
         sum += r;
         squares += r * r;
       }

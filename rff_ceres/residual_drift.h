@@ -8,8 +8,8 @@
 //   ratio = sum_batches (sum_{i in batch} r_i)^2 / sum_i r_i^2,
 //
 // pooled over the landmarks, is about 1 for white errors and
-// 1 + 2 sum_{k<B} (1 - k/B) rho_k for errors of autocorrelation rho_k: the
-// batch-means estimate of their integrated autocorrelation time (Flegal and
+// 1 + 2 sum_{k=1}^{B-1} (1 - k/B) rho_k for errors of autocorrelation rho_k:
+// the batch-means estimate of their integrated autocorrelation time (Flegal and
 // Jones 2010). Residuals beyond 5 robust sigmas (1.4826 times the median
 // |r|) count as at that level: a robust loss's outliers would decide it.
 #ifndef RFF_CERES_RESIDUAL_DRIFT_H_
@@ -41,12 +41,13 @@ struct ResidualDrift {
   bool drifts = false;
 };
 
-// The drift of one kind's residuals, `series` one landmark's each in time
-// order; batches = 0 when no landmark has a whole batch.
+// The drift of one kind's residuals over batches of kDriftBatch, `series`
+// one landmark's each in time order. batches = 0 (nothing judged) when no
+// landmark has a whole batch or the median |r| is 0 (more than half the
+// rows fit exactly: the clip level, and every row, is 0).
 ResidualDrift MeasureResidualDrift(
     const std::string& kind,
-    const std::map<LandmarkId, std::vector<double>>& series,
-    int batch = kDriftBatch);
+    const std::map<LandmarkId, std::vector<double>>& series);
 
 }  // namespace rff
 

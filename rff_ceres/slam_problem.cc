@@ -403,6 +403,15 @@ std::string SlamProblem::Describe(ceres::ResidualBlockId id) const {
   return text;
 }
 
+bool SlamProblem::EvaluateWithoutLoss(ceres::ResidualBlockId id,
+                                      std::vector<double>* residuals) {
+  residuals->assign(
+      problem_->GetCostFunctionForResidualBlock(id)->num_residuals(), 0.0);
+  double cost = 0.0;
+  return problem_->EvaluateResidualBlock(id, /*apply_loss_function=*/false,
+                                         &cost, residuals->data(), nullptr);
+}
+
 std::map<std::string, std::vector<double>> SlamProblem::WhitenedResidualsByKind(
     bool stated_sigmas) {
   std::map<std::string, std::vector<double>> by_kind;
@@ -414,13 +423,7 @@ std::map<std::string, std::vector<double>> SlamProblem::WhitenedResidualsByKind(
     const auto source = sources_.find(id);
     const char* name =
         source == sources_.end() ? "trajectory prior" : source->second.kind;
-    residuals.assign(
-        problem_->GetCostFunctionForResidualBlock(id)->num_residuals(), 0.0);
-    double cost = 0.0;
-    if (!problem_->EvaluateResidualBlock(id, /*apply_loss_function=*/false,
-                                         &cost, residuals.data(), nullptr)) {
-      continue;
-    }
+    if (!EvaluateWithoutLoss(id, &residuals)) continue;
     for (std::size_t row = 0; stated_sigmas && row < residuals.size();
          ++row) {
       residuals[row] *= NoiseScale(
@@ -447,13 +450,7 @@ SlamProblem::ObservationResidualSeries() {
         (first != VarianceGroup::kRange && first != VarianceGroup::kBearing)) {
       continue;
     }
-    residuals.assign(
-        problem_->GetCostFunctionForResidualBlock(id)->num_residuals(), 0.0);
-    double cost = 0.0;
-    if (!problem_->EvaluateResidualBlock(id, /*apply_loss_function=*/false,
-                                         &cost, residuals.data(), nullptr)) {
-      continue;
-    }
+    if (!EvaluateWithoutLoss(id, &residuals)) continue;
     for (std::size_t row = 0; row < residuals.size(); ++row) {
       timed[source.RowGroup(static_cast<int>(row))][source.landmark]
           .emplace_back(source.t0, residuals[row]);

@@ -225,7 +225,7 @@ class SlamProblem {
       bool stated_sigmas = false);
   // The whitened residuals (without the robust loss) of each landmark's
   // observations in time order, per sensor value (kRange, kBearing; a
-  // range-bearing row goes to each).
+  // range-bearing block's rows go one to each).
   std::map<VarianceGroup, std::map<LandmarkId, std::vector<double>>>
   ObservationResidualSeries();
   bool CheckLandmarksDetermined(double max_condition, std::string* error);
@@ -296,6 +296,10 @@ class SlamProblem {
     }
   };
   std::string Describe(ceres::ResidualBlockId id) const;
+  // The block's whitened residuals without its robust loss; false where
+  // Ceres cannot evaluate it (a non-finite residual).
+  bool EvaluateWithoutLoss(ceres::ResidualBlockId id,
+                           std::vector<double>* residuals);
   // A calibration block `values` under the prior N(mean, diag(sigma^2)) (a
   // residual of kind `kind`, a literal), held within [lower, upper].
   void AddCalibration(const char* kind, const Eigen::Vector2d& mean,
@@ -331,7 +335,8 @@ class SlamProblem {
   std::vector<ceres::CostFunction*> prior_costs_;
   bool weighted_ = true;
   bool built_ = false;
-  // Looked up only, once per residual block in each pass over them.
+  // Looked up once per residual block in each pass over them, or walked
+  // (ObservationResidualSeries, which orders what it finds).
   std::unordered_map<ceres::ResidualBlockId, Source> sources_;
   // Ceres's own lookup scans every residual (without fast removal).
   std::map<LandmarkId, std::vector<ceres::ResidualBlockId>> landmark_residuals_;

@@ -384,6 +384,47 @@ TEST(VarianceComponentsTest, ResidualsAtTheStatedSigmasUndoTheNoiseScales) {
   EXPECT_GT(scaled.at("range-bearing").size(), 0u);
 }
 
+// Each landmark's series (residual_drift.h) holds its range-bearing rows,
+// the range and the bearing values apart, in time order, whatever order
+// the data came in: here reversed, as the blocks are added.
+TEST(VarianceComponentsTest, ObservationSeriesAreEachLandmarksRowsInTimeOrder) {
+  Dataset dataset = WnoaDraw(3, 40, 0.05, 0.01);
+  std::reverse(dataset.observations.begin(), dataset.observations.end());
+  SlamOptions options;
+  options.prior = "wnoa";
+  std::unique_ptr<TrajectoryModel> model;
+  ModelAboutAConstantMean(dataset, options, &model);
+  ASSERT_NE(model, nullptr);
+  SlamProblem problem(model.get(), options.problem);
+  std::string error;
+  ASSERT_TRUE(problem.Build(
+      dataset, TrueLandmarks(dataset, Eigen::Vector2d(0.3, -0.2)), &error))
+      << error;
+  // Rows in the order the blocks were added: two per observation.
+  const std::vector<double> rows =
+      problem.WhitenedResidualsByKind().at("range-bearing");
+  ASSERT_EQ(rows.size(), 2 * dataset.observations.size());
+  std::map<LandmarkId, std::vector<std::pair<double, int>>> sightings;
+  for (std::size_t i = 0; i < dataset.observations.size(); ++i) {
+    const Observation& o = dataset.observations[i];
+    sightings[o.id].emplace_back(o.t, static_cast<int>(i));
+  }
+  const auto series = problem.ObservationResidualSeries();
+  const auto& ranges = series.at(VarianceGroup::kRange);
+  const auto& bearings = series.at(VarianceGroup::kBearing);
+  ASSERT_EQ(ranges.size(), sightings.size());
+  for (auto& [id, seen] : sightings) {
+    std::sort(seen.begin(), seen.end());
+    ASSERT_EQ(ranges.at(id).size(), seen.size()) << id;
+    ASSERT_EQ(bearings.at(id).size(), seen.size()) << id;
+    for (std::size_t k = 0; k < seen.size(); ++k) {
+      EXPECT_EQ(ranges.at(id)[k], rows[2 * seen[k].second]) << id << " " << k;
+      EXPECT_EQ(bearings.at(id)[k], rows[2 * seen[k].second + 1])
+          << id << " " << k;
+    }
+  }
+}
+
 // The Hutchinson redundancies match the exact traces of H^-1 J_g^T J_g
 // (dense inverse) on a small problem, and the factors are r^T r / redundancy.
 void ExpectRedundanciesMatchTheExactTraces(const SlamOptions& given) {

@@ -187,12 +187,20 @@ def test_result_arrays(solved):
     assert "60 poses" in repr(solved)
 
 
-def test_residual_drift_comes_with_the_covariance(solved, plain):
-    # White simulated errors: each value judged, none drifting.
+def test_residual_drift_comes_with_the_covariance(small, solved, plain):
+    # Both values of every range-bearing row, in whole batches of 16 of a
+    # landmark's sightings (10 here: too few to call a drift).
+    sightings = {}
+    for line in small.read_text().splitlines():
+        fields = line.split()
+        if fields and fields[0] == "RANGE_BEARING":
+            sightings[fields[2]] = sightings.get(fields[2], 0) + 1
+    batches = sum(count // 16 for count in sightings.values())
     drift = solved.summary["residual_drift"]
     assert sorted(d["kind"] for d in drift) == ["bearing", "range"]
     for d in drift:
-        assert d["batches"] > 0 and math.isfinite(d["ratio"])
+        assert d["batches"] == batches
+        assert 0.0 < d["ratio"] <= 16.0
         assert d["drifts"] is False
     assert plain.summary["residual_drift"] == []
 
