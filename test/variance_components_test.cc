@@ -352,6 +352,28 @@ TEST(VarianceComponentsTest, NoiseFreeDataStopAtTheSigmaBound) {
   EXPECT_EQ(result.learning_rounds, 12);
 }
 
+// The problem of `dataset` under `options` about a constant mean (its model
+// in `model`), built at the true landmarks moved by (0.3, -0.2); null, with
+// a failure recorded, where it cannot be built.
+std::unique_ptr<SlamProblem> ProblemAtShiftedLandmarks(
+    const Dataset& dataset, const SlamOptions& options,
+    std::unique_ptr<TrajectoryModel>* model) {
+  ModelAboutAConstantMean(dataset, options, model);
+  if (*model == nullptr) {
+    ADD_FAILURE() << "no model";
+    return nullptr;
+  }
+  auto problem = std::make_unique<SlamProblem>(model->get(), options.problem);
+  std::string error;
+  if (!problem->Build(dataset,
+                      TrueLandmarks(dataset, Eigen::Vector2d(0.3, -0.2)),
+                      &error)) {
+    ADD_FAILURE() << error;
+    return nullptr;
+  }
+  return problem;
+}
+
 // The problem solves with the noise-scaled sigmas; its residuals at the
 // stated ones (what the quality verdict judges) are those times the scale of
 // each row's kind, and every other kind's are unchanged.
@@ -362,15 +384,11 @@ TEST(VarianceComponentsTest, ResidualsAtTheStatedSigmasUndoTheNoiseScales) {
   options.problem.noise.range = 0.5;
   options.problem.noise.bearing = 4.0;
   std::unique_ptr<TrajectoryModel> model;
-  ModelAboutAConstantMean(dataset, options, &model);
-  ASSERT_NE(model, nullptr);
-  SlamProblem problem(model.get(), options.problem);
-  std::string error;
-  ASSERT_TRUE(problem.Build(
-      dataset, TrueLandmarks(dataset, Eigen::Vector2d(0.3, -0.2)), &error))
-      << error;
-  const auto scaled = problem.WhitenedResidualsByKind();
-  const auto stated = problem.WhitenedResidualsByKind(/*stated_sigmas=*/true);
+  const std::unique_ptr<SlamProblem> problem =
+      ProblemAtShiftedLandmarks(dataset, options, &model);
+  ASSERT_NE(problem, nullptr);
+  const auto scaled = problem->WhitenedResidualsByKind();
+  const auto stated = problem->WhitenedResidualsByKind(/*stated_sigmas=*/true);
   ASSERT_EQ(scaled.size(), stated.size());
   for (const auto& [kind, rows] : scaled) {
     const std::vector<double>& at_stated = stated.at(kind);
@@ -393,23 +411,19 @@ TEST(VarianceComponentsTest, ObservationSeriesAreEachLandmarksRowsInTimeOrder) {
   SlamOptions options;
   options.prior = "wnoa";
   std::unique_ptr<TrajectoryModel> model;
-  ModelAboutAConstantMean(dataset, options, &model);
-  ASSERT_NE(model, nullptr);
-  SlamProblem problem(model.get(), options.problem);
-  std::string error;
-  ASSERT_TRUE(problem.Build(
-      dataset, TrueLandmarks(dataset, Eigen::Vector2d(0.3, -0.2)), &error))
-      << error;
+  const std::unique_ptr<SlamProblem> problem =
+      ProblemAtShiftedLandmarks(dataset, options, &model);
+  ASSERT_NE(problem, nullptr);
   // Rows in the order the blocks were added: two per observation.
   const std::vector<double> rows =
-      problem.WhitenedResidualsByKind().at("range-bearing");
+      problem->WhitenedResidualsByKind().at("range-bearing");
   ASSERT_EQ(rows.size(), 2 * dataset.observations.size());
   std::map<LandmarkId, std::vector<std::pair<double, int>>> sightings;
   for (std::size_t i = 0; i < dataset.observations.size(); ++i) {
     const Observation& o = dataset.observations[i];
     sightings[o.id].emplace_back(o.t, static_cast<int>(i));
   }
-  const auto series = problem.ObservationResidualSeries();
+  const auto series = problem->ObservationResidualSeries();
   const auto& ranges = series.at(VarianceGroup::kRange);
   const auto& bearings = series.at(VarianceGroup::kBearing);
   ASSERT_EQ(ranges.size(), sightings.size());
