@@ -5,6 +5,8 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
+#include <random>
 #include <fstream>
 #include <ios>
 #include <sstream>
@@ -94,14 +96,40 @@ TEST(TextParserTest, WrapsAnglesToHalfOpenInterval) {
   EXPECT_NEAR(WrapAngle(3.0 * M_PI / 2.0), -M_PI / 2.0, 1e-15);
   EXPECT_NEAR(WrapAngle(-7.0), -7.0 + 2.0 * M_PI, 1e-15);
   EXPECT_DOUBLE_EQ(WrapAngle(0.25), 0.25);
-  // The in-range shortcut returns what remainder() does, bit for bit.
-  for (const double a :
-       {std::nextafter(-M_PI, 0.0), -1e-300, 0.0, 3.0,
-        std::nextafter(M_PI, 0.0), M_PI, std::nextafter(M_PI, 4.0),
-        std::nextafter(-M_PI, -4.0)}) {
-    double expected = std::remainder(a, 2.0 * M_PI);
-    if (expected <= -M_PI) expected += 2.0 * M_PI;
-    EXPECT_EQ(WrapAngle(a), expected) << a;
+}
+
+// WrapAngle's shortcuts return what remainder() does, bit for bit: angles
+// in range, odd multiples of pi and their neighbours (where the quotient's
+// rounding can miss the turn), random angles up to 1e9 rad and past the
+// 2^40 where remainder() takes over.
+TEST(TextParserTest, WrappedAnglesAreRemaindersBitForBit) {
+  auto remainder_wrap = [](double a) {
+    double wrapped = std::remainder(a, 2.0 * M_PI);
+    if (wrapped <= -M_PI) wrapped += 2.0 * M_PI;
+    return wrapped;
+  };
+  std::vector<double> angles = {-1e-300, 0.0, -0.0, 3.0, M_PI, -M_PI,
+                                0x1p40, -0x1p40, 1e15, -1e300};
+  for (double k = 1.0; k < 2e6; k = 2.0 * k + 1.0) {
+    for (const double sign : {1.0, -1.0}) {
+      double a = sign * k * M_PI;
+      for (int step = 0; step < 4; ++step) a = std::nextafter(a, 0.0);
+      for (int step = 0; step < 9; ++step) {
+        angles.push_back(a);
+        a = std::nextafter(a, sign * 1e300);
+      }
+    }
+  }
+  std::mt19937_64 random(5);
+  for (const double scale : {10.0, 1e4, 1e9}) {
+    std::uniform_real_distribution<double> uniform(-scale, scale);
+    for (int i = 0; i < 20000; ++i) angles.push_back(uniform(random));
+  }
+  for (const double a : angles) {
+    const double expected = remainder_wrap(a);
+    const double wrapped = WrapAngle(a);
+    ASSERT_EQ(std::memcmp(&wrapped, &expected, sizeof(double)), 0)
+        << std::hexfloat << a << ": " << wrapped << " != " << expected;
   }
 }
 
