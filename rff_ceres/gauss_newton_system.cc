@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <unordered_map>
+#include <unordered_set>
 #include <utility>
 #include <vector>
 
@@ -124,20 +125,35 @@ Eigen::MatrixXd LeadingGram(const RowMajorSparse& j, int t) {
 }  // namespace
 
 std::vector<double*> LandmarksLast(SlamProblem* problem, int* num_leading) {
-  std::vector<double*> blocks, order, landmarks;
-  problem->problem()->GetParameterBlocks(&blocks);
-  const auto ordering = problem->Ordering();
-  *num_leading = 0;
-  for (double* block : blocks) {
-    if (ordering != nullptr && ordering->IsMember(block) &&
-        ordering->GroupId(block) == 0) {
-      landmarks.push_back(block);
-    } else {
-      order.push_back(block);
-      *num_leading += problem->problem()->ParameterBlockSize(block);
+  // The problem's own order: Ceres lists its blocks by address, which
+  // follows the heap's layout, and the sums over columns with it.
+  // Blocks outside BandColumns (none the problem adds today) follow the
+  // model's and calibrations in Ceres's order.
+  ceres::Problem* ceres_problem = problem->problem();
+  const BandedColumns columns = problem->BandColumns();
+  std::vector<double*> order;
+  for (const std::vector<double*>* group : {&columns.timed, &columns.last}) {
+    for (double* block : *group) {
+      if (ceres_problem->HasParameterBlock(block)) order.push_back(block);
     }
   }
-  order.insert(order.end(), landmarks.begin(), landmarks.end());
+  const std::unordered_set<const double*> placed(columns.placed.begin(),
+                                                 columns.placed.end());
+  std::unordered_set<const double*> listed(order.begin(), order.end());
+  std::vector<double*> blocks;
+  ceres_problem->GetParameterBlocks(&blocks);
+  for (double* block : blocks) {
+    if (listed.count(block) == 0 && placed.count(block) == 0) {
+      order.push_back(block);
+    }
+  }
+  *num_leading = 0;
+  for (double* block : order) {
+    *num_leading += ceres_problem->ParameterBlockSize(block);
+  }
+  for (double* block : columns.placed) {
+    if (ceres_problem->HasParameterBlock(block)) order.push_back(block);
+  }
   return order;
 }
 

@@ -37,9 +37,10 @@ inline constexpr double kMinReciprocalCondition = 1e-14;
 
 using RowMajorSparse = Eigen::SparseMatrix<double, Eigen::RowMajor>;
 
-// The problem's parameter blocks with its landmarks (the ordering's group 0)
-// last, in the problem's order; `*num_leading` gets the parameters before
-// them. The column order GaussNewtonSystem expects.
+// The problem's parameter blocks with its landmarks last: the model's in
+// its order, its shared blocks and calibrations, then the landmarks by id
+// (SlamProblem::BandColumns, not the heap's order); `*num_leading` gets the
+// parameters before them. The column order GaussNewtonSystem expects.
 std::vector<double*> LandmarksLast(SlamProblem* problem, int* num_leading);
 
 // Where each column of a Jacobian over the blocks `columns` goes in the

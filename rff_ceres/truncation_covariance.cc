@@ -140,8 +140,8 @@ void AddTruncationCovariance(
   wide.set_odometry_calibration(problem->odometry_calibration());
 
   ceres::Problem* ceres_problem = wide.problem();
-  std::vector<double*> blocks;
-  ceres_problem->GetParameterBlocks(&blocks);
+  int num_leading = 0;
+  const std::vector<double*> blocks = LandmarksLast(&wide, &num_leading);
   for (double* block : blocks) {
     if (ceres_problem->IsParameterBlockConstant(block)) {
       *note = "none: a parameter block is held constant";

@@ -284,6 +284,42 @@ void BuildSmallProblem(int seed, const SlamOptions& options,
       << error;
 }
 
+// The columns of the covariance and the variance components: the model's
+// blocks in its order, the calibrations, the landmarks by id, whatever the
+// heap's order of their storage (Ceres lists blocks by address).
+TEST(LandmarksLastTest, TakesTheProblemsOwnOrder) {
+  SlamOptions options;
+  options.prior = "wnoa";
+  options.problem.range_calibration.estimate = true;
+  options.problem.odometry_calibration.estimate = true;
+  SmallProblem built;
+  BuildSmallProblem(2, options, &built);
+  ASSERT_NE(built.problem, nullptr);
+  SlamProblem& problem = *built.problem;
+  int num_leading = 0;
+  const std::vector<double*> columns = LandmarksLast(&problem, &num_leading);
+  std::vector<double*> expected;
+  int leading = 0;
+  for (int b = 0; b < built.model->num_blocks(); ++b) {
+    expected.push_back(built.model->mutable_block(b));
+    leading += built.model->block_size(b);
+  }
+  // The range calibration, then the odometry's: no shared model blocks.
+  const BandedColumns band_columns = problem.BandColumns();
+  for (double* calibration : band_columns.last) {
+    expected.push_back(calibration);
+    leading += 2;
+  }
+  ASSERT_EQ(expected.size(), built.model->num_blocks() + 2u);
+  for (const auto& [id, position] : problem.landmarks()) {
+    expected.push_back(problem.landmark_block(id));
+  }
+  EXPECT_EQ(columns, expected);
+  EXPECT_EQ(num_leading, leading);
+  EXPECT_EQ(static_cast<int>(columns.size()),
+            problem.problem()->NumParameterBlocks());
+}
+
 // g^T H^-1 g / 2 at the problem's values from its dense Jacobian.
 void DenseDecrease(SlamProblem* problem, double* decrease) {
   std::vector<ceres::ResidualBlockId> ids;
