@@ -56,17 +56,8 @@ std::vector<MapObservation> FindLandmarks(
   return found;
 }
 
-// MapResiduals' row count: one per measured value, whatever the pose.
-int MapRowCount(const std::vector<MapObservation>& observations) {
-  int rows = 0;
-  for (const MapObservation& m : observations) {
-    rows += m.observation->HasRange() + m.observation->HasBearing();
-  }
-  return rows;
-}
-
-// The measured values among `observations` (equations for the unknowns)
-// and the bearings among them.
+// The measured values among `observations` (equations for the unknowns,
+// and MapResiduals' rows whatever the pose) and the bearings among them.
 struct MeasuredValues {
   int equations = 0, bearings = 0;
 };
@@ -164,7 +155,7 @@ class PoseFit {
           const Eigen::Vector3d& start)
       : observations_(observations),
         start_(start),
-        num_rows_(MapRowCount(observations_)) {}
+        num_rows_(CountMeasuredValues(observations_).equations) {}
 
   int NumResiduals() const { return num_rows_; }
 
