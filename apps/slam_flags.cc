@@ -133,6 +133,12 @@ DEFINE_string(odometry_loss, "auto",
               "Robust loss on odometry residuals: none, huber, cauchy, auto.");
 DEFINE_double(odometry_loss_scale, 2.0,
               "Robust odometry loss scale, in sigmas (0.001 to 1000).");
+DEFINE_string(range_bearing_ranges, "auto",
+              "What the range of a RANGE_BEARING record measures: distance, "
+              "depth (along the robot's heading: a camera's range from a "
+              "landmark's apparent size) or auto (depth, with the range "
+              "calibration estimated, where the first solve's residuals "
+              "follow -distance * (1 - cos bearing); batch solves).");
 DEFINE_bool(estimate_range_calibration, false,
             "Estimate a range sensor model scale * distance + offset jointly "
             "(one per run) for the ranges of RANGE and RANGE_BEARING records, "
@@ -266,6 +272,7 @@ SlamOptions SlamOptionsFromFlags() {
   options.problem.odometry_loss.name = FLAGS_odometry_loss;
   options.problem.odometry_loss.scale = FLAGS_odometry_loss_scale;
   options.problem.use_odometry = FLAGS_use_odometry;
+  options.problem.range_bearing_ranges = FLAGS_range_bearing_ranges;
   options.output.covariance_truncation = FLAGS_covariance_truncation;
   RangeCalibrationOptions& calibration = options.problem.range_calibration;
   calibration.estimate = FLAGS_estimate_range_calibration;

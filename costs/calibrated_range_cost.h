@@ -17,6 +17,7 @@
 
 #include "Eigen/Core"
 #include "ceres/cost_function.h"
+#include "costs/depth_bearing_cost.h"
 #include "costs/noise_weighted.h"
 #include "costs/range_bearing_cost.h"
 #include "costs/range_cost.h"
@@ -93,6 +94,17 @@ class CalibratedRangeBearingCost
                              double sigma_range, double sigma_bearing)
       : RangeCalibratedCost(range, sigma_range, std::move(map), 0.0, bearing,
                             sigma_range, sigma_bearing) {}
+};
+
+// A RANGE_BEARING record whose range is a depth (depth_bearing_cost.h):
+// s u^T (l - p) + o, its bearing as measured.
+class CalibratedDepthBearingCost
+    : public RangeCalibratedCost<DepthBearingCost> {
+ public:
+  CalibratedDepthBearingCost(PoseMap map, double depth, double bearing,
+                             double sigma_depth, double sigma_bearing)
+      : RangeCalibratedCost(depth, sigma_depth, std::move(map), 0.0, bearing,
+                            sigma_depth, sigma_bearing) {}
 };
 
 }  // namespace rff

@@ -5,6 +5,7 @@
 
 #include "costs/bearing_cost.h"
 #include "costs/calibrated_range_cost.h"
+#include "costs/depth_bearing_cost.h"
 #include "costs/near_landmark_cost.h"
 #include "costs/range_bearing_cost.h"
 #include "costs/range_cost.h"
@@ -43,8 +44,16 @@ ceres::CostFunction* CreateRangeBearingCost(const Observation& o, PoseMap map,
   }
   if (in.range_calibration != nullptr) {
     blocks->push_back(in.range_calibration);
+    if (in.range_is_depth) {
+      return new CalibratedDepthBearingCost(std::move(map), o.range, o.bearing,
+                                            in.sigma_range, in.sigma_bearing);
+    }
     return new CalibratedRangeBearingCost(std::move(map), o.range, o.bearing,
                                           in.sigma_range, in.sigma_bearing);
+  }
+  if (in.range_is_depth) {
+    return new DepthBearingCost(std::move(map), o.range, o.bearing,
+                                in.sigma_range, in.sigma_bearing);
   }
   return new RangeBearingCost(std::move(map), o.range, o.bearing,
                               in.sigma_range, in.sigma_bearing);

@@ -26,6 +26,9 @@ struct ObservationResidualInputs {
   // The (scale, offset) block of the range sensor when it is estimated,
   // else nullptr.
   double* range_calibration = nullptr;
+  // A RANGE_BEARING record's range is the landmark's depth along the
+  // heading (depth_bearing_cost.h) rather than its distance.
+  bool range_is_depth = false;
 };
 
 // The cost of `o` at the pose `map` over `blocks` (the pose's blocks, then

@@ -196,6 +196,7 @@ void SlamProblem::AddObservation(const Observation& o) {
   if (options_.range_calibration.estimate) {
     inputs.range_calibration = range_calibration_.data();
   }
+  inputs.range_is_depth = options_.range_bearing_ranges == "depth";
   const MeasurementType& type = MeasurementTypeOf(o.type);
   ceres::CostFunction* cost = type.cost(o, std::move(map), inputs, &blocks);
   if (auto* weighted = dynamic_cast<ObservationWeighted*>(cost)) {
@@ -216,7 +217,9 @@ bool CheckCalibrationOptions(const ProblemOptions& options,
   for (const auto& [name, sigma] : sigmas) {
     if (!CheckPositiveOption(sigma, name, error)) return false;
   }
-  return true;
+  return CheckOneOf(options.range_bearing_ranges, "range_bearing_ranges",
+                    "unknown reading of the ranges", RangeBearingRangeNames(),
+                    error);
 }
 
 bool SlamProblem::Begin(const std::vector<LandmarkId>& landmark_ids,

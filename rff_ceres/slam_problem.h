@@ -114,6 +114,10 @@ struct ProblemOptions {
   LossOptions odometry_loss = kDefaultLoss;
   RangeCalibrationOptions range_calibration;
   OdometryCalibrationOptions odometry_calibration;
+  // What the range of a RANGE_BEARING record measures: "distance", "depth"
+  // along the heading (a camera's range from a landmark's apparent size), or
+  // "auto" (range_reading.h: depth where the first solve's residuals say so).
+  std::string range_bearing_ranges = "auto";
   bool use_odometry = true;
   // Compose ODOM chains between observation times into one residual each
   // (see odometry_preintegration.h).
@@ -128,8 +132,14 @@ bool OdometryChains(const Dataset& dataset, const ProblemOptions& options,
                     std::vector<PreintegratedOdometry>* chains,
                     std::string* error);
 
+// The values of ProblemOptions::range_bearing_ranges.
+inline std::vector<std::string> RangeBearingRangeNames() {
+  return {"auto", "distance", "depth"};
+}
+
 // Fails naming the flag of a calibration prior sigma that is not finite and
-// positive (checked whether or not the calibration is estimated).
+// positive (checked whether or not the calibration is estimated), or of an
+// unknown range_bearing_ranges.
 bool CheckCalibrationOptions(const ProblemOptions& options, std::string* error);
 
 // The linear solver of "auto": DENSE_SCHUR when the reduced system (every

@@ -133,8 +133,22 @@ void PrintSlamSummary(const SlamOptions& options, const SlamResult& result,
          << result.start_heading.prior_heading << ")";
   }
   *out << "\n";
-  if (options.problem.range_calibration.estimate) {
-    *out << "  range model  " << result.range_calibration[0] << " * distance + "
+  const bool depth = result.range_bearing_ranges == "depth";
+  if (depth) {
+    *out << "  ranges       RANGE_BEARING ranges read as depths along the "
+            "heading";
+    if (result.range_reading_judged) {
+      *out << " (auto: the first solve's range residuals follow -d (1 - cos "
+              "b), slope "
+           << result.depth_evidence.slope
+           << ", t = " << result.depth_evidence.t_statistic << " > "
+           << kMinDepthEvidence << ")";
+    }
+    *out << "\n";
+  }
+  if (result.range_calibrated) {
+    *out << "  range model  " << result.range_calibration[0]
+         << (depth ? " * depth + " : " * distance + ")
          << result.range_calibration[1] << " m\n";
   }
   if (options.problem.odometry_calibration.estimate &&
@@ -268,6 +282,16 @@ void WriteSummaryJson(const SlamOptions& options, const SlamResult& result,
       << "  \"start_heading_resolved\": "
       << (result.start_heading.resolved ? "true" : "false") << ",\n"
       << "  \"start_heading\": " << FormatNumber(result.start_heading.heading)
+      << ",\n"
+      << "  \"range_bearing_ranges\": "
+      << JsonString(result.range_bearing_ranges) << ",\n"
+      << "  \"depth_evidence\": "
+      << (result.range_reading_judged
+              ? "{\"rows\": " + std::to_string(result.depth_evidence.rows) +
+                    ", \"slope\": " +
+                    FormatNumber(result.depth_evidence.slope) + ", \"t\": " +
+                    FormatNumber(result.depth_evidence.t_statistic) + "}"
+              : std::string("null"))
       << ",\n"
       << "  \"range_scale\": " << FormatNumber(result.range_calibration[0])
       << ",\n"

@@ -181,6 +181,10 @@ bool ReportSolution(const Dataset& dataset, const SlamOptions& options,
                     SlamOptions* settled, SlamProblem* problem,
                     SlamResult* result, std::string* error) {
   result->noise = settled->problem.noise;
+  // Incremental updates read ranges as distances unless told otherwise.
+  result->range_bearing_ranges =
+      settled->problem.range_bearing_ranges == "depth" ? "depth" : "distance";
+  result->range_calibrated = settled->problem.range_calibration.estimate;
   // Incremental updates keep an "auto" loss robust throughout.
   for (LossOptions* loss :
        {&settled->problem.loss, &settled->problem.odometry_loss}) {
@@ -374,6 +378,22 @@ bool RunSlamAtOrigin(const Dataset& dataset, const SlamOptions& options,
                          result, error)) {
     return false;
   } else {
+    if (settled.problem.range_bearing_ranges == "auto") {
+      result->depth_evidence = MeasureDepthEvidence(
+          resolved, [&](double t) { return model->Pose(t); }, landmarks);
+      result->range_reading_judged = true;
+      if (SettleRangeReading(result->depth_evidence, &settled.problem)) {
+        // Depths, through a calibration block: a problem of their own,
+        // judged again from where the distances left it.
+        problem.reset();
+        if (!SolveBatch(dataset, settled,
+                        JudgingOptions(settled.problem, ceres_options),
+                        model.get(), &landmarks, initial_extent, &problem,
+                        result, error)) {
+          return false;
+        }
+      }
+    }
     // Finishes the judging solve: a learning round's solves come first.
     const bool judged = SettleAutoLosses(problem.get(), &settled.problem);
     if (wnoa_learns || correction) {

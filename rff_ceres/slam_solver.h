@@ -19,6 +19,7 @@
 #include "rff_ceres/initialization.h"
 #include "rff_ceres/options.h"
 #include "rff_ceres/quality_report.h"
+#include "rff_ceres/range_reading.h"
 #include "rff_ceres/residual_drift.h"
 #include "rff_ceres/slam_problem.h"
 #include "rff_ceres/types.h"
@@ -88,7 +89,14 @@ struct SlamResult {
   std::string initial_trajectory;  // "localization" (the pilot) or "mean".
   std::string prior_mean;          // The mean "auto" settled on.
   double mean_seconds = 0.0;       // Time to build the mean (a "wnoa" solve).
-  // (scale, offset) of the range sensor; (1, 0) unless estimated.
+  // What the RANGE_BEARING ranges were read as, "distance" or "depth", and
+  // the first solve's evidence where "auto" decided (range_reading.h).
+  std::string range_bearing_ranges;
+  bool range_reading_judged = false;
+  DepthEvidence depth_evidence;
+  // (scale, offset) of the range sensor; (1, 0) unless estimated, which
+  // the options or a depth reading ask for.
+  bool range_calibrated = false;
   Eigen::Vector2d range_calibration = Eigen::Vector2d(1.0, 0.0);
   // (translation scale, turn scale) of the odometry; (1, 1) unless estimated.
   Eigen::Vector2d odometry_calibration = Eigen::Vector2d(1.0, 1.0);

@@ -99,6 +99,14 @@ std::shared_ptr<const MeanFunction> BuildMean(
       settled->problem.odometry_loss.name = "none";
     }
     settled->problem.noise = wnoa.noise;  // Learned from the same data.
+    // The same sensors: their ranges read as that solve settled them.
+    if (options.problem.range_bearing_ranges == "auto") {
+      settled->problem.range_bearing_ranges = wnoa.range_bearing_ranges;
+      settled->problem.range_calibration.estimate |=
+          wnoa.range_bearing_ranges == "depth";
+      result->range_reading_judged = wnoa.range_reading_judged;
+      result->depth_evidence = wnoa.depth_evidence;
+    }
     result->noise_kept = wnoa.noise_kept;
     result->noise_learned = wnoa.noise_learned;
     // The solve's landmarks start the RFF solve either way: as a mean, the
