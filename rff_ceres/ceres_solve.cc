@@ -216,7 +216,8 @@ bool RunSolve(const SolverOptions& solver, ceres::Solver::Options ceres_options,
       // The only bounded blocks here.
       if (why == "a parameter has bounds") {
         why +=
-            " (the self-calibrations of --estimate_range_calibration and "
+            " (the self-calibrations of --estimate_range_calibration, on "
+            "where ranges are read as depths, and "
             "--estimate_odometry_calibration have)";
       }
     } else {

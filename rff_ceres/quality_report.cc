@@ -58,6 +58,9 @@ QualityReport AssessQuality(
     report.reasons.push_back("the solver stopped before convergence (" +
                              facts.termination + ")");
   }
+  for (const std::string& reason : facts.mean_reasons) {
+    report.reasons.push_back("its WNOA mean: " + reason);
+  }
   if (facts.predicted_decrease > kMaxPredictedDecrease) {
     report.reasons.push_back(
         "the Gauss-Newton model still expects the cost to fall by " +

@@ -78,6 +78,10 @@ struct SolveFacts {
   // Stretches where the heading winds whole turns against the odometry
   // (heading_winding.h): a local minimum.
   std::vector<std::string> heading_windings;
+  // The suspect reasons of a WNOA solve the estimate is a correction to:
+  // where the correction keeps (near) none of the variance, its solve is
+  // the estimate's.
+  std::vector<std::string> mean_reasons;
 };
 
 // `residuals`: whitened residuals by kind (SlamProblem::

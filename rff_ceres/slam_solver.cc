@@ -208,6 +208,7 @@ bool ReportSolution(const Dataset& dataset, const SlamOptions& options,
     // Judged against the data as stated: learned sigmas would absorb a
     // misfit.
     SolveFacts facts = SolveFactsOf(*settled, *result);
+    facts.mean_reasons = wnoa_mean_solve.quality.reasons;
     facts.predicted_decrease =
         options.incremental.every == 0
             ? GaussNewtonDecrease(problem, &facts.predicted_decrease_exact)

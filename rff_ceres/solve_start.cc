@@ -18,13 +18,15 @@ namespace {
 // The WNOA solve the RFF prior starts from: a batch solve of its own with
 // the same problem options, with its covariance when `covariance`.
 bool SolveWnoa(const Dataset& dataset, const SlamOptions& options,
-               bool covariance, SlamResult* solve, std::string* error) {
+               bool covariance, bool judged, SlamResult* solve,
+               std::string* error) {
   SlamOptions wnoa = options;
   wnoa.prior = WnoaPrior().name();
   wnoa.mean.name = "auto";
   wnoa.mean.outer_rounds = 0;
   wnoa.output.covariance = covariance;
-  wnoa.output.quality = false;
+  // A mean the estimate corrects is judged with it (SolveFacts).
+  wnoa.output.quality = judged && options.output.quality;
   // The user's linear solver is for the RFF solve; banded states want their
   // own (AutoLinearSolverType).
   wnoa.solver.linear_solver = "auto";
@@ -89,7 +91,7 @@ std::shared_ptr<const MeanFunction> BuildMean(
     SlamResult wnoa;
     const bool wnoa_mean = result->prior_mean == "wnoa";
     if (!SolveWnoa(dataset, options, wnoa_mean && options.output.covariance,
-                   &wnoa, error)) {
+                   wnoa_mean, &wnoa, error)) {
       return nullptr;
     }
     // The same data: a loss the WNOA solve found no outlier for is dropped

@@ -110,6 +110,25 @@ TEST(QualityReportTest, UnconvergedSolveAndCalibrationAtItsBoundAreSuspect) {
                           "held by its bound"));
 }
 
+// A correction to a WNOA mean is that mean where it keeps no variance: the
+// mean's own reasons are the estimate's. On the bundled MRCLAM robot 1 with
+// --trust_region_strategy=DOGLEG the mean stops at NO_CONVERGENCE; before,
+// the verdict was ok at 6.5 times the default's error.
+TEST(QualityReportTest, ASuspectMeanMakesTheCorrectionSuspect) {
+  SolveFacts facts;
+  facts.mean_reasons = {
+      "the solver stopped before convergence (NO_CONVERGENCE)"};
+  QualityReport report =
+      AssessQuality({{"range", StandardNormal(500, 1.0, 3)}}, facts);
+  EXPECT_EQ(report.verdict, "suspect");
+  EXPECT_THAT(report.reasons, ElementsAre("its WNOA mean: the solver stopped "
+                                          "before convergence "
+                                          "(NO_CONVERGENCE)"));
+  facts.mean_reasons.clear();
+  report = AssessQuality({{"range", StandardNormal(500, 1.0, 3)}}, facts);
+  EXPECT_EQ(report.verdict, "ok");
+}
+
 // A solve cut off by its iteration cap stands where the exact decrease
 // (banded states) vouches for it; a lower bound (feature models) does not.
 TEST(QualityReportTest, CutOffSolveAtItsMinimumByTheExactDecreaseIsOk) {

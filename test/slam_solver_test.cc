@@ -815,9 +815,10 @@ INSTANTIATE_TEST_SUITE_P(
                     o->problem.range_calibration.estimate = true;
                   },
                   "--linear_solver=BANDED_CHOLESKY: a parameter has bounds "
-                  "(the self-calibrations of --estimate_range_calibration "
-                  "and --estimate_odometry_calibration have); allowed auto "
-                  "or a Ceres linear solver"},
+                  "(the self-calibrations of --estimate_range_calibration, "
+                  "on where ranges are read as depths, and "
+                  "--estimate_odometry_calibration have); allowed auto or a "
+                  "Ceres linear solver"},
         BadOption{"CgnrWithSchurPreconditioner",
                   [](SlamOptions* o) {
                     o->solver.linear_solver = "CGNR";
