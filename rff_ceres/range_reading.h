@@ -29,8 +29,8 @@ struct DepthEvidence {
 };
 
 // Depths where the slope is positive and its t statistic above this: on
-// the tune side the MRCLAM robots give 26-52, simulated and laser sets
-// under 1 (docs/heldout.md).
+// the held-out protocol's tune side MRCLAM's first solves give 19.5-33 and
+// every other file under 1.6 in size (docs/heldout.md).
 inline constexpr double kMinDepthEvidence = 10.0;
 
 // The regression above over the RANGE_BEARING records of `dataset` whose
