@@ -49,24 +49,27 @@ QualityReport AssessQuality(
     const SolveFacts& facts) {
   QualityReport report;
   report.predicted_decrease = facts.predicted_decrease;
+  auto solve_reason = [&report](const std::string& reason) {
+    report.reasons.push_back(reason);
+    report.solve_reasons.push_back(reason);
+  };
   // A solve cut off by its iteration or time limit stands where the exact
   // Gauss-Newton decrease vouches for it, as a converged one does; a bound
   // from below cannot.
   const bool at_minimum = facts.predicted_decrease_exact &&
                           facts.predicted_decrease <= kMaxPredictedDecrease;
   if (!facts.converged && !at_minimum) {
-    report.reasons.push_back("the solver stopped before convergence (" +
-                             facts.termination + ")");
+    solve_reason("the solver stopped before convergence (" + facts.termination +
+                 ")");
   }
   for (const std::string& reason : facts.mean_reasons) {
-    report.reasons.push_back("its WNOA mean: " + reason);
+    solve_reason("its WNOA mean: " + reason);
   }
   if (facts.predicted_decrease > kMaxPredictedDecrease) {
-    report.reasons.push_back(
-        "the Gauss-Newton model still expects the cost to fall by " +
-        Short(facts.predicted_decrease) + " (more than " +
-        Short(kMaxPredictedDecrease) +
-        "): the solve stopped short of its minimum");
+    solve_reason("the Gauss-Newton model still expects the cost to fall by " +
+                 Short(facts.predicted_decrease) + " (more than " +
+                 Short(kMaxPredictedDecrease) +
+                 "): the solve stopped short of its minimum");
   }
   for (const auto& [kind, values] : residuals) {
     if (values.empty()) continue;
@@ -105,20 +108,19 @@ QualityReport AssessQuality(
     report.kinds.push_back(q);
   }
   if (facts.range_calibration_at_bound) {
-    report.reasons.push_back("the range calibration (scale " +
-                             Short(facts.range_calibration[0]) + ", offset " +
-                             Short(facts.range_calibration[1]) +
-                             " m) is held by its bound");
+    solve_reason("the range calibration (scale " +
+                 Short(facts.range_calibration[0]) + ", offset " +
+                 Short(facts.range_calibration[1]) +
+                 " m) is held by its bound");
   }
   if (facts.odometry_calibration_at_bound) {
-    report.reasons.push_back(
-        "the odometry calibration (scale " +
-        Short(facts.odometry_calibration[0]) + ", turn scale " +
-        Short(facts.odometry_calibration[1]) + ") is held by its bound");
+    solve_reason("the odometry calibration (scale " +
+                 Short(facts.odometry_calibration[0]) + ", turn scale " +
+                 Short(facts.odometry_calibration[1]) +
+                 ") is held by its bound");
   }
   for (const std::string& winding : facts.heading_windings) {
-    report.reasons.push_back("the heading winds against the odometry from " +
-                             winding);
+    solve_reason("the heading winds against the odometry from " + winding);
   }
   if (!report.reasons.empty()) report.verdict = "suspect";
   return report;

@@ -53,6 +53,10 @@ struct QualityReport {
   std::vector<ResidualKindQuality> kinds;  // Sorted by kind.
   std::string verdict = "ok";              // "ok", "suspect" or "not judged"
   std::vector<std::string> reasons;        // Why "suspect", one line each.
+  // Those of `reasons` about the solve rather than its residuals (where it
+  // stopped, its calibrations' bounds, its heading): what a correction to
+  // it keeps (SolveFacts::mean_reasons).
+  std::vector<std::string> solve_reasons;
   double predicted_decrease = 0.0;         // SolveFacts's, NaN if unknown.
   bool suspect() const { return verdict != "ok"; }
 };
@@ -78,9 +82,9 @@ struct SolveFacts {
   // Stretches where the heading winds whole turns against the odometry
   // (heading_winding.h): a local minimum.
   std::vector<std::string> heading_windings;
-  // The suspect reasons of a WNOA solve the estimate is a correction to:
-  // where the correction keeps (near) none of the variance, its solve is
-  // the estimate's.
+  // The solve reasons of a WNOA solve the estimate is a correction to:
+  // where the correction keeps (near) none of the variance, that solve is
+  // the estimate's (its residuals are judged again as the estimate's).
   std::vector<std::string> mean_reasons;
 };
 

@@ -145,6 +145,11 @@ void PrintSlamSummary(const SlamOptions& options, const SlamResult& result,
            << kMinDepthEvidence << ")";
     }
     *out << "\n";
+  } else if (result.depth_rejected) {
+    *out << "  ranges       RANGE_BEARING ranges read as distances: their "
+            "residuals follow -d (1 - cos b) (t = "
+         << result.depth_evidence.t_statistic
+         << "), but read as depths the first solve's cost was no lower\n";
   }
   if (result.range_calibrated) {
     *out << "  range model  " << result.range_calibration[0]
@@ -290,7 +295,9 @@ void WriteSummaryJson(const SlamOptions& options, const SlamResult& result,
               ? "{\"rows\": " + std::to_string(result.depth_evidence.rows) +
                     ", \"slope\": " +
                     FormatNumber(result.depth_evidence.slope) + ", \"t\": " +
-                    FormatNumber(result.depth_evidence.t_statistic) + "}"
+                    FormatNumber(result.depth_evidence.t_statistic) +
+                    ", \"rejected\": " +
+                    (result.depth_rejected ? "true" : "false") + "}"
               : std::string("null"))
       << ",\n"
       << "  \"range_scale\": " << FormatNumber(result.range_calibration[0])

@@ -208,7 +208,7 @@ bool ReportSolution(const Dataset& dataset, const SlamOptions& options,
     // Judged against the data as stated: learned sigmas would absorb a
     // misfit.
     SolveFacts facts = SolveFactsOf(*settled, *result);
-    facts.mean_reasons = wnoa_mean_solve.quality.reasons;
+    facts.mean_reasons = wnoa_mean_solve.quality.solve_reasons;
     facts.predicted_decrease =
         options.incremental.every == 0
             ? GaussNewtonDecrease(problem, &facts.predicted_decrease_exact)
@@ -379,19 +379,29 @@ bool RunSlamAtOrigin(const Dataset& dataset, const SlamOptions& options,
                          result, error)) {
     return false;
   } else {
-    if (settled.problem.range_bearing_ranges == "auto") {
+    // Judged at a minimum only: the residuals of a solve cut short may
+    // follow any regressor.
+    if (settled.problem.range_bearing_ranges == "auto" &&
+        result->summary.termination_type == ceres::CONVERGENCE) {
       result->depth_evidence = MeasureDepthEvidence(
           resolved, [&](double t) { return model->Pose(t); }, landmarks);
       result->range_reading_judged = true;
+      const double distance_cost = result->summary.final_cost;
+      auto judge_again = [&] {
+        problem.reset();  // Another cost per range-bearing record.
+        return SolveBatch(
+            dataset, settled, JudgingOptions(settled.problem, ceres_options),
+            model.get(), &landmarks, initial_extent, &problem, result, error);
+      };
       if (SettleRangeReading(result->depth_evidence, &settled.problem)) {
-        // Depths, through a calibration block: a problem of their own,
-        // judged again from where the distances left it.
-        problem.reset();
-        if (!SolveBatch(dataset, settled,
-                        JudgingOptions(settled.problem, ceres_options),
-                        model.get(), &landmarks, initial_extent, &problem,
-                        result, error)) {
-          return false;
+        if (!judge_again()) return false;
+        if (!(result->summary.final_cost < distance_cost)) {
+          // Depths that fit no better than distances: distances after all.
+          settled.problem.range_bearing_ranges = "distance";
+          settled.problem.range_calibration.estimate =
+              options.problem.range_calibration.estimate;
+          result->depth_rejected = true;
+          if (!judge_again()) return false;
         }
       }
     }

@@ -94,6 +94,9 @@ struct SlamResult {
   std::string range_bearing_ranges;
   bool range_reading_judged = false;
   DepthEvidence depth_evidence;
+  // The evidence said depths, but read so the first solve's cost was not
+  // lower: read as distances.
+  bool depth_rejected = false;
   // (scale, offset) of the range sensor; (1, 0) unless estimated, which
   // the options or a depth reading ask for.
   bool range_calibrated = false;

@@ -108,6 +108,7 @@ std::shared_ptr<const MeanFunction> BuildMean(
           wnoa.range_bearing_ranges == "depth";
       result->range_reading_judged = wnoa.range_reading_judged;
       result->depth_evidence = wnoa.depth_evidence;
+      result->depth_rejected = wnoa.depth_rejected;
     }
     result->noise_kept = wnoa.noise_kept;
     result->noise_learned = wnoa.noise_learned;

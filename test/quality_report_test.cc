@@ -127,6 +127,15 @@ TEST(QualityReportTest, ASuspectMeanMakesTheCorrectionSuspect) {
   facts.mean_reasons.clear();
   report = AssessQuality({{"range", StandardNormal(500, 1.0, 3)}}, facts);
   EXPECT_EQ(report.verdict, "ok");
+  // What a correction inherits: the solve's reasons, not its residuals'
+  // (the correction's own residuals are judged again).
+  facts.converged = false;
+  facts.termination = "NO_CONVERGENCE";
+  report = AssessQuality({{"range", StandardNormal(500, 3.0, 3)}}, facts);
+  EXPECT_EQ(report.reasons.size(), 3u);
+  EXPECT_THAT(report.solve_reasons,
+              ElementsAre("the solver stopped before convergence "
+                          "(NO_CONVERGENCE)"));
 }
 
 // A solve cut off by its iteration cap stands where the exact decrease

@@ -351,3 +351,21 @@ def test_a_failed_solve_is_a_runtime_error(tmp_path):
     empty.write_text("RFFD 1\nPRIOR_POSE 0 0 0 0 0.1 0.1\n")
     with pytest.raises(RuntimeError, match=f"{empty}: .*nothing to estimate"):
         rffslam.solve(empty)
+
+
+def test_the_range_reading_is_in_the_summary(small, plain):
+    # The simulator's ranges are distances: judged so from every
+    # range-bearing row (a landmark's prior places each one here), and a
+    # reading given is not judged.
+    rows = sum(1 for line in small.read_text().splitlines()
+               if line.split()[:1] == ["RANGE_BEARING"])
+    assert plain.summary["range_bearing_ranges"] == "distance"
+    evidence = plain.summary["depth_evidence"]
+    assert 0 < evidence["rows"] <= rows
+    assert abs(evidence["t"]) < 10.0
+    given = rffslam.solve(small, range_bearing_ranges="depth")
+    assert given.summary["range_bearing_ranges"] == "depth"
+    assert given.summary["depth_evidence"] is None
+    with pytest.raises(ValueError, match="--range_bearing_ranges=depths: "
+                                         "unknown reading of the ranges"):
+        rffslam.solve(small, range_bearing_ranges="depths")
