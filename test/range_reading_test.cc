@@ -169,9 +169,10 @@ Dataset CameraRun(std::uint64_t seed) {
   return dataset;
 }
 
-// The same run with every range read as the landmark's depth along the
-// heading (its error kept): z - d + d cos(b) with the truth's d and b.
-Dataset AsDepths(Dataset dataset) {
+// The same run with every range moved by `share` of the way from the
+// landmark's distance to its depth along the heading (its error kept):
+// z + share d (cos(b) - 1) with the truth's d and b; 1 reads depths.
+Dataset AsDepths(Dataset dataset, double share = 1.0) {
   std::map<LandmarkId, Eigen::Vector2d> truth;
   for (const Landmark& l : dataset.ground_truth_landmarks) {
     truth[l.id] = Eigen::Vector2d(l.x, l.y);
@@ -182,7 +183,7 @@ Dataset AsDepths(Dataset dataset) {
     const TimedPose& p = poses.at(o.t);
     const Eigen::Vector2d delta = truth.at(o.id) - Eigen::Vector2d(p.x, p.y);
     const double bearing = std::atan2(delta.y(), delta.x()) - p.theta;
-    o.range += delta.norm() * (std::cos(bearing) - 1.0);
+    o.range += share * delta.norm() * (std::cos(bearing) - 1.0);
   }
   return dataset;
 }
@@ -237,6 +238,37 @@ TEST(RangeReadingSolveTest, AutoReadsACamerasDepthsAndLeavesDistances) {
             std::string::npos)
       << summary.str();
   EXPECT_NE(summary.str().find(" * depth + "), std::string::npos);
+}
+
+// Evidence without a minimum, or for a reading that fits worse, reads
+// distances: the first solve cut at one iteration is not judged, and ranges
+// a third of the way to depths (slope about 0.3, t far above 10) fit worse
+// read as depths, so they are read as distances and said to be.
+TEST(RangeReadingSolveTest, DepthsWithoutAMinimumOrABetterFitAreNotTaken) {
+  const Dataset distances = CameraRun(3);
+  SlamOptions options;
+  options.prior = "wnoa";
+  SlamOptions cut = options;
+  cut.solver.max_iterations = 1;
+  std::string error;
+  SlamResult result;
+  ASSERT_TRUE(RunSlam(AsDepths(distances), cut, &result, &error)) << error;
+  EXPECT_FALSE(result.range_reading_judged);
+  EXPECT_EQ(result.range_bearing_ranges, "distance");
+
+  ASSERT_TRUE(RunSlam(AsDepths(distances, 0.3), options, &result, &error))
+      << error;
+  EXPECT_TRUE(result.range_reading_judged);
+  EXPECT_GT(result.depth_evidence.t_statistic, kMinDepthEvidence);
+  EXPECT_TRUE(result.depth_rejected);
+  EXPECT_EQ(result.range_bearing_ranges, "distance");
+  EXPECT_FALSE(result.range_calibrated);
+  std::ostringstream summary;
+  PrintSlamSummary(options, result, &summary);
+  EXPECT_NE(summary.str().find("ranges       RANGE_BEARING ranges read as "
+                               "distances: their residuals follow"),
+            std::string::npos)
+      << summary.str();
 }
 
 }  // namespace
