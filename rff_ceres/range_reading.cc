@@ -2,9 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <vector>
 
+#include "Eigen/Cholesky"
 #include "costs/angle.h"
 #include "costs/near_landmark_cost.h"
 #include "rff_ceres/statistics.h"
@@ -15,8 +15,10 @@ DepthEvidence MeasureDepthEvidence(
     const Dataset& dataset,
     const std::function<Eigen::Vector3d(double)>& pose_at,
     const std::map<LandmarkId, Eigen::Vector2d>& landmarks) {
+  // Rows (1 / sigma, d / sigma, g) and r: an offset and a scale, which a
+  // range calibration takes, beside what reading depths changes.
+  std::vector<Eigen::Vector3d> rows;
   std::vector<double> residuals;
-  std::vector<double> regressors;
   for (const Observation& o : dataset.observations) {
     const auto landmark = landmarks.find(o.id);
     if (o.type != ObservationType::kRangeBearing ||
@@ -30,29 +32,38 @@ DepthEvidence MeasureDepthEvidence(
     const double bearing =
         WrapAngle(std::atan2(delta.y(), delta.x()) - pose.z());
     residuals.push_back((o.range - distance) / o.sigma_range);
-    regressors.push_back(-distance * (1.0 - std::cos(bearing)) / o.sigma_range);
+    rows.emplace_back(1.0 / o.sigma_range, distance / o.sigma_range,
+                      -distance * (1.0 - std::cos(bearing)) / o.sigma_range);
   }
   std::vector<double> sizes;
   for (const double r : residuals) sizes.push_back(std::abs(r));
-  const double level = 5.0 * 1.4826 * Median(sizes);
-  double rg = 0.0, gg = 0.0, rr = 0.0;
+  // A floor for residuals that are nearly all zero (noise-free data).
+  const double level = std::max(5.0 * 1.4826 * Median(sizes), 1e-6);
+  Eigen::Matrix3d normal = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d projected = Eigen::Vector3d::Zero();
+  double rr = 0.0;
   DepthEvidence evidence;
   for (std::size_t i = 0; i < residuals.size(); ++i) {
     if (!(std::abs(residuals[i]) <= level)) continue;
-    rg += residuals[i] * regressors[i];
-    gg += regressors[i] * regressors[i];
+    normal += rows[i] * rows[i].transpose();
+    projected += rows[i] * residuals[i];
     rr += residuals[i] * residuals[i];
     ++evidence.rows;
   }
-  if (evidence.rows < 3 || !(gg > 0.0)) return evidence;
-  evidence.slope = rg / gg;
-  // Residual variance of the fit r = slope g, with n - 1 degrees of freedom.
+  if (evidence.rows < 4) return evidence;
+  const Eigen::LDLT<Eigen::Matrix3d> ldlt(normal);
+  const Eigen::Vector3d coefficients = ldlt.solve(projected);
+  const Eigen::Matrix3d inverse = ldlt.solve(Eigen::Matrix3d::Identity());
+  // The last coefficient's standard error: residual variance on n - 3
+  // degrees of freedom times (N^-1)_33.
   const double misfit =
-      std::max(0.0, rr - evidence.slope * rg) / (evidence.rows - 1);
-  evidence.t_statistic =
-      misfit > 0.0 ? evidence.slope / std::sqrt(misfit / gg)
-                   : std::copysign(std::numeric_limits<double>::infinity(),
-                                   evidence.slope);
+      std::max(0.0, rr - coefficients.dot(projected)) / (evidence.rows - 3);
+  if (ldlt.info() != Eigen::Success || !coefficients.allFinite() ||
+      !(inverse(2, 2) > 0.0) || !(misfit > 0.0)) {
+    return evidence;  // Collinear columns or an exact fit: nothing told.
+  }
+  evidence.slope = coefficients[2];
+  evidence.t_statistic = evidence.slope / std::sqrt(misfit * inverse(2, 2));
   return evidence;
 }
 

@@ -5,11 +5,15 @@
 // -|l - p| (1 - cos b), up to 0.45 m at the image's edges).
 //
 // After a solve that read them as distances, the whitened range residuals
-// r_i = (z_i - d_i) / sigma_i are regressed on what reading them as depths
-// changes, g_i = -d_i (1 - cos b_i) / sigma_i (d, b the estimate's distance
-// and bearing): the slope is 0 for distances and at most 1 for depths (less
-// where the fit bent the trajectory to them); its t statistic says whether
-// the data tell the two apart.
+// r_i = (z_i - d_i) / sigma_i are regressed on an offset and a scale
+// (1 / sigma_i, d_i / sigma_i: a range calibration's, so that a biased
+// distance sensor is not taken for a camera) and on what reading them as
+// depths changes, g_i = -d_i (1 - cos b_i) / sigma_i (d, b the estimate's
+// distance and bearing). g's slope is 0 for distances and at most 1 for
+// depths (less where the fit bent the trajectory to them); its t statistic
+// says whether the data tell the two apart. It counts rows as independent,
+// which a camera's consecutive sightings are not, hence a threshold far
+// above a test's usual 2-3.
 #ifndef RFF_CERES_RANGE_READING_H_
 #define RFF_CERES_RANGE_READING_H_
 
@@ -24,8 +28,8 @@ namespace rff {
 
 struct DepthEvidence {
   int rows = 0;  // Range-bearing rows regressed, outliers left out.
-  double slope = 0.0;
-  double t_statistic = 0.0;
+  double slope = 0.0;        // Of g; 0 where nothing is told.
+  double t_statistic = 0.0;  // Finite; 0 where nothing is told.
 };
 
 // Depths where the slope is positive and its t statistic above this: on
@@ -41,6 +45,12 @@ DepthEvidence MeasureDepthEvidence(
     const Dataset& dataset,
     const std::function<Eigen::Vector3d(double)>& pose_at,
     const std::map<LandmarkId, Eigen::Vector2d>& landmarks);
+
+// Why "auto" is not judged under --linear_solver=BANDED_CHOLESKY, whose
+// minimiser takes no bounds.
+inline constexpr char kBandedReadingNote[] =
+    "auto not judged: --linear_solver=BANDED_CHOLESKY cannot take the range "
+    "calibration that depths need";
 
 // Settles range_bearing_ranges "auto" by `evidence`: "depth", with the range
 // calibration estimated (a camera's depth scale and its place on the robot

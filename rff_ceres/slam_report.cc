@@ -145,6 +145,9 @@ void PrintSlamSummary(const SlamOptions& options, const SlamResult& result,
            << kMinDepthEvidence << ")";
     }
     *out << "\n";
+  } else if (!result.range_reading_note.empty()) {
+    *out << "  ranges       RANGE_BEARING ranges read as distances, "
+         << result.range_reading_note << "\n";
   } else if (result.depth_rejected) {
     *out << "  ranges       RANGE_BEARING ranges read as distances: their "
             "residuals follow -d (1 - cos b) (t = "
@@ -290,6 +293,8 @@ void WriteSummaryJson(const SlamOptions& options, const SlamResult& result,
       << ",\n"
       << "  \"range_bearing_ranges\": "
       << JsonString(result.range_bearing_ranges) << ",\n"
+      << "  \"range_reading_note\": " << JsonString(result.range_reading_note)
+      << ",\n"
       << "  \"depth_evidence\": "
       << (result.range_reading_judged
               ? "{\"rows\": " + std::to_string(result.depth_evidence.rows) +

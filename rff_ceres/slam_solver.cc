@@ -55,9 +55,11 @@ SolveFacts SolveFactsOf(const SlamOptions& options, const SlamResult& result) {
   const double offset_bound =
       kMaxOffsetSigmas * options.problem.range_calibration.offset_sigma;
   constexpr double kAtBound = 1e-6;
+  // Judged where estimated (settled: depths turn it on).
   facts.range_calibration_at_bound =
-      scale < kMinRangeScale + kAtBound || scale > kMaxRangeScale - kAtBound ||
-      std::abs(result.range_calibration[1]) > offset_bound * (1.0 - kAtBound);
+      options.problem.range_calibration.estimate &&
+      (scale < kMinRangeScale + kAtBound || scale > kMaxRangeScale - kAtBound ||
+       std::abs(result.range_calibration[1]) > offset_bound * (1.0 - kAtBound));
   facts.odometry_calibration = result.odometry_calibration;
   facts.odometry_calibration_at_bound =
       result.odometry_calibration.minCoeff() < kMinOdometryScale + kAtBound ||
@@ -380,9 +382,16 @@ bool RunSlamAtOrigin(const Dataset& dataset, const SlamOptions& options,
     return false;
   } else {
     // Judged at a minimum only: the residuals of a solve cut short may
-    // follow any regressor.
+    // follow any regressor. BANDED_CHOLESKY takes no calibration's bounds.
     if (settled.problem.range_bearing_ranges == "auto" &&
-        result->summary.termination_type == ceres::CONVERGENCE) {
+        result->summary.termination_type != ceres::CONVERGENCE) {
+      result->range_reading_note = "auto not judged: the first solve ended " +
+                                   std::string(ceres::TerminationTypeToString(
+                                       result->summary.termination_type));
+    } else if (settled.problem.range_bearing_ranges == "auto" &&
+               options.solver.linear_solver == "BANDED_CHOLESKY") {
+      result->range_reading_note = kBandedReadingNote;
+    } else if (settled.problem.range_bearing_ranges == "auto") {
       result->depth_evidence = MeasureDepthEvidence(
           resolved, [&](double t) { return model->Pose(t); }, landmarks);
       result->range_reading_judged = true;
@@ -400,6 +409,9 @@ bool RunSlamAtOrigin(const Dataset& dataset, const SlamOptions& options,
           settled.problem.range_bearing_ranges = "distance";
           settled.problem.range_calibration.estimate =
               options.problem.range_calibration.estimate;
+          if (!settled.problem.range_calibration.estimate) {
+            result->range_calibration = Eigen::Vector2d(1.0, 0.0);
+          }
           result->depth_rejected = true;
           if (!judge_again()) return false;
         }

@@ -97,6 +97,9 @@ struct SlamResult {
   // The evidence said depths, but read so the first solve's cost was not
   // lower: read as distances.
   bool depth_rejected = false;
+  // Why "auto" was not judged (the reading is then distances); empty if it
+  // was or a reading was given.
+  std::string range_reading_note;
   // (scale, offset) of the range sensor; (1, 0) unless estimated, which
   // the options or a depth reading ask for.
   bool range_calibrated = false;

@@ -11,6 +11,7 @@
 #include "rff_ceres/initialization.h"
 #include "rff_ceres/mean/prior_mean.h"
 #include "rff_ceres/priors/trajectory_prior.h"
+#include "rff_ceres/range_reading.h"
 
 namespace rff {
 namespace {
@@ -31,6 +32,11 @@ bool SolveWnoa(const Dataset& dataset, const SlamOptions& options,
   // own (AutoLinearSolverType).
   wnoa.solver.linear_solver = "auto";
   wnoa.solver.preconditioner = "auto";
+  // Nor could that solver take a depth reading's calibration.
+  if (options.solver.linear_solver == "BANDED_CHOLESKY" &&
+      wnoa.problem.range_bearing_ranges == "auto") {
+    wnoa.problem.range_bearing_ranges = "distance";
+  }
   return RunSlam(dataset, wnoa, solve, error);
 }
 
@@ -109,6 +115,10 @@ std::shared_ptr<const MeanFunction> BuildMean(
       result->range_reading_judged = wnoa.range_reading_judged;
       result->depth_evidence = wnoa.depth_evidence;
       result->depth_rejected = wnoa.depth_rejected;
+      result->range_reading_note =
+          options.solver.linear_solver == "BANDED_CHOLESKY"
+              ? kBandedReadingNote
+              : wnoa.range_reading_note;
     }
     result->noise_kept = wnoa.noise_kept;
     result->noise_learned = wnoa.noise_learned;

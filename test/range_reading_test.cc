@@ -6,6 +6,7 @@
 #include <sstream>
 #include <string>
 
+#include "Eigen/Dense"
 #include "gtest/gtest.h"
 #include "rff_ceres/metrics.h"
 #include "rff_ceres/simulate.h"
@@ -16,98 +17,106 @@
 namespace rff {
 namespace {
 
-// A robot at the origin heading along x, and landmarks on a circle of 4 m
+// A robot at the origin heading along x, and landmarks at distances of 2-8 m
 // seen at bearings in [-0.6, 0.6] rad (a camera's view): their ranges read
-// as distances or as depths, with white errors of 0.05 m.
-Dataset CameraRows(bool depth, int count, std::uint64_t seed) {
+// as `scale` times the distance or the depth plus `offset`, with white
+// errors of 0.05 m.
+struct CameraRows {
+  Dataset dataset;
+  std::map<LandmarkId, Eigen::Vector2d> landmarks;
+};
+CameraRows MakeCameraRows(bool depth, int count, std::uint64_t seed,
+                          double scale = 1.0, double offset = 0.0) {
   std::mt19937_64 rng(seed);
   std::normal_distribution<double> noise(0.0, 0.05);
-  Dataset dataset;
+  CameraRows rows;
   for (int i = 0; i < count; ++i) {
+    const double bearing = -0.6 + 1.2 * i / (count - 1);
+    const double distance = 2.0 + 6.0 * ((i * 7) % count) / count;
     Observation o;
     o.type = ObservationType::kRangeBearing;
     o.t = i;
     o.id = i;
-    const double bearing = -0.6 + 1.2 * i / (count - 1);
-    o.range = (depth ? 4.0 * std::cos(bearing) : 4.0) + noise(rng);
+    o.range = scale * distance * (depth ? std::cos(bearing) : 1.0) + offset +
+              noise(rng);
     o.bearing = bearing;
     o.sigma_range = 0.05;
     o.sigma_bearing = 0.01;
-    dataset.observations.push_back(o);
+    rows.dataset.observations.push_back(o);
+    rows.landmarks[i] =
+        distance * Eigen::Vector2d(std::cos(bearing), std::sin(bearing));
   }
-  return dataset;
-}
-
-std::map<LandmarkId, Eigen::Vector2d> CircleLandmarks(int count) {
-  std::map<LandmarkId, Eigen::Vector2d> landmarks;
-  for (int i = 0; i < count; ++i) {
-    const double bearing = -0.6 + 1.2 * i / (count - 1);
-    landmarks[i] = 4.0 * Eigen::Vector2d(std::cos(bearing), std::sin(bearing));
-  }
-  return landmarks;
+  return rows;
 }
 
 Eigen::Vector3d AtOrigin(double /*t*/) { return Eigen::Vector3d::Zero(); }
 
 TEST(RangeReadingTest, DepthsGiveASlopeOfOneAndDistancesNone) {
-  const auto landmarks = CircleLandmarks(400);
-  const DepthEvidence depths =
-      MeasureDepthEvidence(CameraRows(true, 400, 1), AtOrigin, landmarks);
-  EXPECT_EQ(depths.rows, 400);
-  // g ranges over 0 to 0.7 sigma: the slope to about 1 / sqrt(sum g^2).
-  EXPECT_NEAR(depths.slope, 1.0, 0.15);
-  EXPECT_GT(depths.t_statistic, 10.0);
-  const DepthEvidence distances =
-      MeasureDepthEvidence(CameraRows(false, 400, 1), AtOrigin, landmarks);
-  EXPECT_EQ(distances.rows, 400);
-  EXPECT_LT(std::abs(distances.t_statistic), 3.0);
+  const CameraRows depths = MakeCameraRows(true, 400, 1);
+  const DepthEvidence evidence =
+      MeasureDepthEvidence(depths.dataset, AtOrigin, depths.landmarks);
+  EXPECT_EQ(evidence.rows, 400);
+  EXPECT_NEAR(evidence.slope, 1.0, 0.05);
+  EXPECT_GT(evidence.t_statistic, 10.0);
+  const CameraRows distances = MakeCameraRows(false, 400, 1);
+  const DepthEvidence none =
+      MeasureDepthEvidence(distances.dataset, AtOrigin, distances.landmarks);
+  EXPECT_EQ(none.rows, 400);
+  EXPECT_LT(std::abs(none.t_statistic), 3.0);
 }
 
-TEST(RangeReadingTest, ExactSlopeAndTheRowsItLeavesOut) {
-  // Three rows at bearings 0, 0.5 and -0.5 with residuals 0, -1 and -2
-  // sigmas: g = 0 and -4 (1 - cos 0.5) / 0.05 twice, so slope = -(1 + 2) g1
-  // / (2 g1^2) and t from the misfit left.
-  Dataset dataset;
-  std::map<LandmarkId, Eigen::Vector2d> landmarks;
-  const double bearings[3] = {0.0, 0.5, -0.5};
-  const double residuals[3] = {0.0, -1.0, -2.0};
-  for (int i = 0; i < 3; ++i) {
-    Observation o;
-    o.type = ObservationType::kRangeBearing;
-    o.id = i;
-    o.range = 4.0 + 0.05 * residuals[i];
-    o.bearing = bearings[i];
-    o.sigma_range = 0.05;
-    o.sigma_bearing = 0.01;
-    dataset.observations.push_back(o);
-    landmarks[i] =
-        4.0 * Eigen::Vector2d(std::cos(bearings[i]), std::sin(bearings[i]));
+// A distance sensor that reads 5% short and 0.2 m under (what the range
+// calibration takes) is no camera: the offset and scale columns take it.
+TEST(RangeReadingTest, ABiasedDistanceSensorIsNotTakenForDepths) {
+  const CameraRows biased = MakeCameraRows(false, 400, 2, 0.95, -0.2);
+  const DepthEvidence evidence =
+      MeasureDepthEvidence(biased.dataset, AtOrigin, biased.landmarks);
+  EXPECT_EQ(evidence.rows, 400);
+  EXPECT_LT(std::abs(evidence.t_statistic), 3.0);
+  // Depths through the same sensor still are.
+  const CameraRows camera = MakeCameraRows(true, 400, 2, 0.95, -0.2);
+  EXPECT_GT(MeasureDepthEvidence(camera.dataset, AtOrigin, camera.landmarks)
+                .t_statistic,
+            10.0);
+}
+
+TEST(RangeReadingTest, TheFitIsLeastSquaresOverTheRowsItKeeps) {
+  CameraRows rows = MakeCameraRows(true, 8, 3);
+  // The regression in the test's own terms: Householder QR of the rows.
+  Eigen::MatrixXd a(8, 3);
+  Eigen::VectorXd r(8);
+  for (int i = 0; i < 8; ++i) {
+    const Observation& o = rows.dataset.observations[i];
+    const double d = rows.landmarks.at(o.id).norm();
+    a.row(i) << 1.0 / 0.05, d / 0.05, -d * (1.0 - std::cos(o.bearing)) / 0.05;
+    r[i] = (o.range - d) / 0.05;
   }
+  const Eigen::Vector3d x = a.householderQr().solve(r);
+  const double misfit = (r - a * x).squaredNorm() / (8 - 3);
+  const double t =
+      x[2] / std::sqrt(misfit * (a.transpose() * a).inverse()(2, 2));
   // Left out: a range-only record, a landmark not placed, a range under 2
   // sigmas (the near-landmark form) and a residual beyond 5 robust sigmas.
-  Observation range_only = dataset.observations[1];
+  Observation range_only = rows.dataset.observations[1];
   range_only.type = ObservationType::kRange;
-  dataset.observations.push_back(range_only);
-  Observation unplaced = dataset.observations[1];
+  Observation unplaced = rows.dataset.observations[1];
   unplaced.id = 99;
-  dataset.observations.push_back(unplaced);
-  Observation near = dataset.observations[1];
+  Observation near = rows.dataset.observations[1];
   near.range = 0.09;
-  dataset.observations.push_back(near);
-  Observation outlier = dataset.observations[1];
-  outlier.range = 4.0 + 0.05 * 100.0;
-  dataset.observations.push_back(outlier);
-
+  Observation outlier = rows.dataset.observations[1];
+  outlier.range += 100.0;
+  for (const Observation& o : {range_only, unplaced, near, outlier}) {
+    rows.dataset.observations.push_back(o);
+  }
   const DepthEvidence evidence =
-      MeasureDepthEvidence(dataset, AtOrigin, landmarks);
-  EXPECT_EQ(evidence.rows, 3);
-  const double g1 = -4.0 * (1.0 - std::cos(0.5)) / 0.05;
-  const double slope = -3.0 * g1 / (2.0 * g1 * g1);
-  EXPECT_NEAR(evidence.slope, slope, 1e-12);
-  // Misfit: the two rows at 0.5 rad leave -1 - slope g1 = 0.5 and -0.5.
-  const double misfit = 0.5 / 2.0;
-  EXPECT_NEAR(evidence.t_statistic, slope / std::sqrt(misfit / (2 * g1 * g1)),
-              1e-9);
+      MeasureDepthEvidence(rows.dataset, AtOrigin, rows.landmarks);
+  EXPECT_EQ(evidence.rows, 8);
+  EXPECT_NEAR(evidence.slope, x[2], 1e-9 * std::abs(x[2]));
+  EXPECT_NEAR(evidence.t_statistic, t, 1e-7 * std::abs(t));
+  // Too few rows, or none varying: nothing told.
+  rows.dataset.observations.resize(3);
+  EXPECT_EQ(MeasureDepthEvidence(rows.dataset, AtOrigin, rows.landmarks).slope,
+            0.0);
 }
 
 TEST(RangeReadingTest, AutoSettlesOnTheEvidenceAndAGivenReadingStays) {
@@ -198,10 +207,10 @@ double ApeOf(const Dataset& dataset, const SlamResult& result) {
   return evaluation.ape_translation.rms;
 }
 
-// Measured at the commit that added it (seed 3): distances judged as such
-// (t 0.56) and solved as before, bit for bit (APE 0.149 m); the same run
-// with depths judged as depths (t 14.7, calibration 0.9999 and 0.011 m) and
-// solved to 0.150 m, where reading them as distances ends 0.260 m off.
+// Measured (seed 3): distances judged as such (t 0.51) and solved as
+// before, bit for bit (APE 0.149 m); the same run with depths judged as
+// depths (t 20.8, calibration 0.9999 and 0.011 m) and solved to 0.150 m,
+// where reading them as distances ends 0.260 m off.
 TEST(RangeReadingSolveTest, AutoReadsACamerasDepthsAndLeavesDistances) {
   const Dataset distances = CameraRun(3);
   SlamOptions options;
@@ -242,7 +251,7 @@ TEST(RangeReadingSolveTest, AutoReadsACamerasDepthsAndLeavesDistances) {
 
 // Evidence without a minimum, or for a reading that fits worse, reads
 // distances: the first solve cut at one iteration is not judged, and ranges
-// a third of the way to depths (slope about 0.3, t far above 10) fit worse
+// a third of the way to depths (slope 0.17, t 20.2) fit worse
 // read as depths, so they are read as distances and said to be.
 TEST(RangeReadingSolveTest, DepthsWithoutAMinimumOrABetterFitAreNotTaken) {
   const Dataset distances = CameraRun(3);
