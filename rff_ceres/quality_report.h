@@ -82,9 +82,10 @@ struct SolveFacts {
   // Stretches where the heading winds whole turns against the odometry
   // (heading_winding.h): a local minimum.
   std::vector<std::string> heading_windings;
-  // The solve reasons of a WNOA solve the estimate is a correction to:
-  // where the correction keeps (near) none of the variance, that solve is
-  // the estimate's (its residuals are judged again as the estimate's).
+  // The solve reasons of the WNOA solve that is the estimate's prior mean:
+  // the correction starts from it, and where it keeps (near) none of the
+  // variance it is that solve (its residuals are judged again as the
+  // estimate's).
   std::vector<std::string> mean_reasons;
 };
 

@@ -33,8 +33,8 @@ struct DepthEvidence {
 };
 
 // Depths where the slope is positive and its t statistic above this: on
-// the held-out protocol's tune side MRCLAM's first solves give 19.5-33 and
-// every other file under 1.6 in size (docs/heldout.md).
+// the held-out protocol's tune side MRCLAM's first solves give 26.6-62.8 and
+// every other file under 0.83 in size (docs/heldout.md).
 inline constexpr double kMinDepthEvidence = 10.0;
 
 // The regression above over the RANGE_BEARING records of `dataset` whose

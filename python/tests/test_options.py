@@ -354,9 +354,9 @@ def test_a_failed_solve_is_a_runtime_error(tmp_path):
 
 
 def test_the_range_reading_is_in_the_summary(small, plain):
-    # The simulator's ranges are distances: judged so from every
-    # range-bearing row (a landmark's prior places each one here), and a
-    # reading given is not judged.
+    # The simulator's ranges are distances: judged so from the range-bearing
+    # rows (those beyond 5 robust sigmas left out), and a reading given is
+    # not judged.
     rows = sum(1 for line in small.read_text().splitlines()
                if line.split()[:1] == ["RANGE_BEARING"])
     assert plain.summary["range_bearing_ranges"] == "distance"
