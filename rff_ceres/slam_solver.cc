@@ -383,8 +383,15 @@ bool RunSlamAtOrigin(const Dataset& dataset, const SlamOptions& options,
   } else {
     // Judged at a minimum only: the residuals of a solve cut short may
     // follow any regressor. BANDED_CHOLESKY takes no calibration's bounds.
-    if (settled.problem.range_bearing_ranges == "auto" &&
-        result->summary.termination_type != ceres::CONVERGENCE) {
+    const bool range_bearing =
+        std::any_of(dataset.observations.begin(), dataset.observations.end(),
+                    [](const Observation& o) {
+                      return o.type == ObservationType::kRangeBearing;
+                    });
+    if (!range_bearing) {
+      // Nothing to read.
+    } else if (settled.problem.range_bearing_ranges == "auto" &&
+               result->summary.termination_type != ceres::CONVERGENCE) {
       result->range_reading_note = "auto not judged: the first solve ended " +
                                    std::string(ceres::TerminationTypeToString(
                                        result->summary.termination_type));
