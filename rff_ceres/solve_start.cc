@@ -33,11 +33,12 @@ bool SolveWnoa(const Dataset& dataset, const SlamOptions& options,
   wnoa.solver.linear_solver = "auto";
   wnoa.solver.preconditioner = "auto";
   // Nor could that solver take a depth reading's calibration.
-  if (options.solver.linear_solver == "BANDED_CHOLESKY" &&
-      wnoa.problem.range_bearing_ranges == "auto") {
-    wnoa.problem.range_bearing_ranges = "distance";
-  }
-  return RunSlam(dataset, wnoa, solve, error);
+  const bool unjudged = options.solver.linear_solver == "BANDED_CHOLESKY" &&
+                        wnoa.problem.range_bearing_ranges == "auto";
+  if (unjudged) wnoa.problem.range_bearing_ranges = "distance";
+  if (!RunSlam(dataset, wnoa, solve, error)) return false;
+  if (unjudged) solve->range_reading_note = kBandedReadingNote;
+  return true;
 }
 
 }  // namespace
@@ -115,10 +116,7 @@ std::shared_ptr<const MeanFunction> BuildMean(
       result->range_reading_judged = wnoa.range_reading_judged;
       result->depth_evidence = wnoa.depth_evidence;
       result->depth_rejected = wnoa.depth_rejected;
-      result->range_reading_note =
-          options.solver.linear_solver == "BANDED_CHOLESKY"
-              ? kBandedReadingNote
-              : wnoa.range_reading_note;
+      result->range_reading_note = wnoa.range_reading_note;
     }
     result->noise_kept = wnoa.noise_kept;
     result->noise_learned = wnoa.noise_learned;
