@@ -26,12 +26,15 @@ using RowMajorMatrix =
 // Landmarks whose own 2x2 block of J^T J (robustified, as Ceres's
 // covariance sees it) is singular: the data fix fewer than two directions of
 // them (one range, or bearings from one place), so the whole information
-// matrix is singular too.
+// matrix is singular too. A prior fixes both: beside it a block only looks
+// singular where a bearing seen from on top of the landmark dwarfs it.
 std::vector<LandmarkId> UnconstrainedLandmarks(
     SlamProblem* problem, const std::vector<LandmarkId>& ids) {
   std::vector<LandmarkId> unconstrained;
   for (const LandmarkId id : ids) {
-    if (!problem->has_landmark(id)) continue;
+    if (!problem->has_landmark(id) || problem->has_landmark_prior(id)) {
+      continue;
+    }
     const Eigen::Vector2d eigenvalues =
         Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(
             problem->LandmarkInformation(id, /*apply_loss=*/true),

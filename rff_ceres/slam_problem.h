@@ -173,6 +173,9 @@ class SlamProblem {
   bool Begin(const std::vector<LandmarkId>& landmark_ids, std::string* error);
   void AddLandmark(LandmarkId id, const Eigen::Vector2d& initial);
   bool has_landmark(LandmarkId id) const { return added_.count(id) > 0; }
+  bool has_landmark_prior(LandmarkId id) const {
+    return has_prior_.count(id) > 0;
+  }
   void AddLandmarkPrior(const LandmarkPrior& prior);
   void AddPosePrior(const PosePrior& prior);
   void AddOdometry(const PreintegratedOdometry& odometry);

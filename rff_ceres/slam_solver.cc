@@ -235,6 +235,12 @@ bool ReportSolution(const Dataset& dataset, const SlamOptions& options,
     if (!ComputePosteriorCovariance(problem, model, times, covariance_options,
                                     &result->pose_covariances,
                                     &result->landmarks, error)) {
+      // Away from a minimum the Hessian need not be positive definite.
+      const std::vector<std::string>& why = result->quality.solve_reasons;
+      for (std::size_t i = 0; i < why.size(); ++i) {
+        *error += (i == 0 ? "; the solve it is taken at is suspect: " : "; ") +
+                  why[i];
+      }
       return false;
     }
     if (!PriorOf(options).has_features()) {
