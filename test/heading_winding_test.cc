@@ -2,7 +2,6 @@
 
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
 #include <memory>
 #include <string>
 #include <vector>
@@ -10,13 +9,13 @@
 #include "gtest/gtest.h"
 #include "rff_ceres/batch_solver.h"
 #include "rff_ceres/initialization.h"
-#include "rff_ceres/io/dataset_io.h"
 #include "rff_ceres/mean/prior_mean.h"
 #include "rff_ceres/metrics.h"
 #include "rff_ceres/options.h"
 #include "rff_ceres/priors/trajectory_prior.h"
 #include "rff_ceres/quality_report.h"
 #include "test/paper_dataset.h"
+#include "test/shared_data.h"
 
 namespace rff {
 namespace {
@@ -226,12 +225,10 @@ TEST(HeadingWindingTest, ATurnTheDataHaveIsKept) {
 // rotation RMS 9.6 degrees, verdict ok). They are unwound and none is left
 // (measured 3.0 degrees RMS).
 TEST(HeadingWindingSharedTest, SharedMrclamRobot3IsUnwound) {
-  const std::string path = std::string(RFF_SHARED_DIR) +
-                           "/data/heldout/mrclam6_robot3_map_1m_off.rffd";
-  if (!std::filesystem::exists(path)) GTEST_SKIP() << "no " << path;
+  constexpr char kFile[] = "data/heldout/mrclam6_robot3_map_1m_off.rffd";
   Dataset dataset;
+  if (!testing::ReadSharedDataset(kFile, &dataset)) GTEST_SKIP() << kFile;
   std::string error;
-  ASSERT_TRUE(ReadDataset(path, &dataset, &error)) << error;
   SlamOptions options;
   options.prior = "wnoa";
   SlamResult result;

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
 #include <map>
 #include <memory>
 #include <string>
@@ -16,11 +15,11 @@
 #include "rff_ceres/banded_problem.h"
 #include "rff_ceres/ceres_solve.h"
 #include "rff_ceres/feature_trajectory.h"
-#include "rff_ceres/io/dataset_io.h"
 #include "rff_ceres/io/text_parser.h"
 #include "rff_ceres/simulate.h"
 #include "rff_ceres/slam_solver.h"
 #include "rff_ceres/wnoa_trajectory.h"
+#include "test/shared_data.h"
 #include "test/synthetic_options.h"
 
 namespace rff {
@@ -613,12 +612,10 @@ TEST(WnoaMeanCovarianceTest, RffCovarianceContainsTheWnoaSolves) {
 // none is blamed; the error says which solve it was taken at.
 TEST(PosteriorCovarianceSharedTest,
      ASuspectSolveIsNamedWhereTheCovarianceFails) {
-  const std::string path = std::string(RFF_SHARED_DIR) +
-                           "/data/heldout/mrclam6_robot3_map_1m_off.rffd";
-  if (!std::filesystem::exists(path)) GTEST_SKIP() << "no " << path;
+  constexpr char kFile[] = "data/heldout/mrclam6_robot3_map_1m_off.rffd";
   Dataset dataset;
+  if (!testing::ReadSharedDataset(kFile, &dataset)) GTEST_SKIP() << kFile;
   std::string error;
-  ASSERT_TRUE(ReadDataset(path, &dataset, &error)) << error;
   SlamOptions options;
   options.prior = "wnoa";
   options.problem.loss.name = "none";
