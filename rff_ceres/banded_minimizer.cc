@@ -61,16 +61,6 @@ bool BandedSolvable(const ceres::Problem& problem, const BandedColumns& columns,
       *why = "a parameter block has a manifold";
       return false;
     }
-    const int size = problem.ParameterBlockSize(block);
-    for (int i = 0; i < size; ++i) {
-      if (problem.GetParameterLowerBound(block, i) >
-              -std::numeric_limits<double>::max() ||
-          problem.GetParameterUpperBound(block, i) <
-              std::numeric_limits<double>::max()) {
-        *why = "a parameter has bounds";
-        return false;
-      }
-    }
   }
   return true;
 }
@@ -98,7 +88,10 @@ void MinimizeBanded(const ceres::Solver::Options& options,
   summary->num_parameters_reduced = n;
   summary->num_parameter_blocks_reduced = banded->num_variable_blocks();
   const Eigen::VectorXd start_values = banded->Gather();
-  Eigen::VectorXd x = start_values, best = x, gradient(n);
+  // As Ceres's preprocessor: the start projected onto the bounds.
+  Eigen::VectorXd x = start_values;
+  banded->Project(&x);
+  Eigen::VectorXd best = x, gradient(n);
   std::unique_ptr<EnvelopeMatrix> hessian;  // H = J^T J at x.
   // Costs without the fixed cost, which the reported ones include.
   double cost = 0.0, fixed_cost = 0.0;
@@ -295,7 +288,8 @@ void MinimizeBanded(const ceres::Solver::Options& options,
     }
     invalid_steps = 0;
     next.step_is_valid = true;
-    const Eigen::VectorXd candidate = x + step;
+    Eigen::VectorXd candidate = x + step;
+    banded->Project(&candidate);
     next.step_norm = (x - candidate).norm();  // As Ceres: the ambient step.
     if (next.step_norm <=
         options.parameter_tolerance * (x_norm + options.parameter_tolerance)) {

@@ -18,8 +18,9 @@
 namespace rff {
 
 // Whether `problem` can be solved with its parameter blocks laid out as
-// `columns` (every block of the problem once): no manifolds or bounds (this
-// loop does not project). Otherwise false with the cause in `why`.
+// `columns` (every block of the problem once) and no manifolds; bounds are
+// kept as Ceres keeps them (BandedProblem::Project). Otherwise false with
+// the cause in `why`.
 bool BandedSolvable(const ceres::Problem& problem, const BandedColumns& columns,
                     std::string* why);
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <unordered_map>
 #include <unordered_set>
 #include <utility>
@@ -124,6 +125,21 @@ BandedProblem::BandedProblem(const ceres::Problem& problem,
     variable_sizes_.push_back(size);
     num_columns_ += size;
   }
+  constexpr double kUnbounded = std::numeric_limits<double>::max();
+  for (std::size_t b = 0; b < variables_.size(); ++b) {
+    for (int i = 0; i < variable_sizes_[b]; ++i) {
+      const double lower = problem.GetParameterLowerBound(variables_[b], i);
+      const double upper = problem.GetParameterUpperBound(variables_[b], i);
+      if (lower == -kUnbounded && upper == kUnbounded) continue;
+      if (lower_.size() == 0) {
+        lower_.setConstant(num_columns_, -kUnbounded);
+        upper_.setConstant(num_columns_, kUnbounded);
+      }
+      const int column = first_column_[variables_[b]] + i;
+      lower_[column] = lower;
+      upper_[column] = upper;
+    }
+  }
   const std::unordered_set<const double*> timed(columns.timed.begin(),
                                                 columns.timed.end());
   columns_.reserve(blocks_.size());
@@ -197,6 +213,11 @@ Eigen::VectorXd BandedProblem::Gather() const {
     for (int i = 0; i < variable_sizes_[b]; ++i) x[c++] = variables_[b][i];
   }
   return x;
+}
+
+void BandedProblem::Project(Eigen::VectorXd* x) const {
+  if (lower_.size() == 0) return;
+  *x = x->cwiseMax(lower_).cwiseMin(upper_);
 }
 
 void BandedProblem::Scatter(const Eigen::VectorXd& x) const {

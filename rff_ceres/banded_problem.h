@@ -103,6 +103,9 @@ class BandedProblem {
   // The variables' values as a state vector, and back.
   Eigen::VectorXd Gather() const;
   void Scatter(const Eigen::VectorXd& x) const;
+  // `x` clamped to the variables' bounds, as Ceres's ParameterBlock::Plus
+  // projects x + dx onto them (a self-calibration's physical range).
+  void Project(Eigen::VectorXd* x) const;
 
   // The cost of the terms no variable changes; false as Linearize.
   bool FixedCost(double* cost);
@@ -181,6 +184,8 @@ class BandedProblem {
   std::vector<double*> variables_;  // In column order, with their sizes.
   std::unordered_map<const double*, int> first_column_;  // Of variables.
   std::vector<int> variable_sizes_;
+  // Per column: its bounds (infinite where it has none); empty without any.
+  Eigen::VectorXd lower_, upper_;
   std::vector<double*> blocks_;  // Every term's blocks, columns and sizes.
   std::vector<int> columns_, sizes_;
   std::vector<char> in_panel_;

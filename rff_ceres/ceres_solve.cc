@@ -213,13 +213,7 @@ bool RunSolve(const SolverOptions& solver, ceres::Solver::Options ceres_options,
     std::string why;
     std::shared_ptr<BandedProblem> banded;
     if (!BandedSolvable(*problem->problem(), columns, &why)) {
-      // The only bounded blocks here.
-      if (why == "a parameter has bounds") {
-        why +=
-            " (the self-calibrations of --estimate_range_calibration, on "
-            "where ranges are read as depths, and "
-            "--estimate_odometry_calibration have)";
-      }
+      // `why` says it.
     } else {
       banded = problem->BandedLayout(columns);
       const BandedSize size = banded->Size();

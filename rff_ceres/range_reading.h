@@ -46,12 +46,6 @@ DepthEvidence MeasureDepthEvidence(
     const std::function<Eigen::Vector3d(double)>& pose_at,
     const std::map<LandmarkId, Eigen::Vector2d>& landmarks);
 
-// Why "auto" is not judged under --linear_solver=BANDED_CHOLESKY, whose
-// minimiser takes no bounds.
-inline constexpr char kBandedReadingNote[] =
-    "auto not judged: --linear_solver=BANDED_CHOLESKY cannot take the range "
-    "calibration that depths need";
-
 // Settles range_bearing_ranges "auto" by `evidence`: "depth", with the range
 // calibration estimated (a camera's depth scale and its place on the robot
 // are not known), or "distance". True when it became "depth": a problem

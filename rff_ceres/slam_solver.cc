@@ -388,7 +388,7 @@ bool RunSlamAtOrigin(const Dataset& dataset, const SlamOptions& options,
     return false;
   } else {
     // Judged at a minimum only: the residuals of a solve cut short may
-    // follow any regressor. BANDED_CHOLESKY takes no calibration's bounds.
+    // follow any regressor.
     const bool range_bearing =
         std::any_of(dataset.observations.begin(), dataset.observations.end(),
                     [](const Observation& o) {
@@ -401,9 +401,6 @@ bool RunSlamAtOrigin(const Dataset& dataset, const SlamOptions& options,
       result->range_reading_note = "auto not judged: the first solve ended " +
                                    std::string(ceres::TerminationTypeToString(
                                        result->summary.termination_type));
-    } else if (settled.problem.range_bearing_ranges == "auto" &&
-               options.solver.linear_solver == "BANDED_CHOLESKY") {
-      result->range_reading_note = kBandedReadingNote;
     } else if (settled.problem.range_bearing_ranges == "auto") {
       result->depth_evidence = MeasureDepthEvidence(
           resolved, [&](double t) { return model->Pose(t); }, landmarks);

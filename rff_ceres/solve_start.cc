@@ -11,7 +11,6 @@
 #include "rff_ceres/initialization.h"
 #include "rff_ceres/mean/prior_mean.h"
 #include "rff_ceres/priors/trajectory_prior.h"
-#include "rff_ceres/range_reading.h"
 
 namespace rff {
 namespace {
@@ -32,13 +31,7 @@ bool SolveWnoa(const Dataset& dataset, const SlamOptions& options,
   // own (AutoLinearSolverType).
   wnoa.solver.linear_solver = "auto";
   wnoa.solver.preconditioner = "auto";
-  // Nor could that solver take a depth reading's calibration.
-  const bool unjudged = options.solver.linear_solver == "BANDED_CHOLESKY" &&
-                        wnoa.problem.range_bearing_ranges == "auto";
-  if (unjudged) wnoa.problem.range_bearing_ranges = "distance";
-  if (!RunSlam(dataset, wnoa, solve, error)) return false;
-  if (unjudged) solve->range_reading_note = kBandedReadingNote;
-  return true;
+  return RunSlam(dataset, wnoa, solve, error);
 }
 
 }  // namespace

@@ -208,6 +208,20 @@ TEST(SlamSolverTest, BandedCholeskyMatchesCeresSparseCholesky) {
   ExpectAutoTakesTheEnvelopeWithCeresSteps(dataset, options);
 }
 
+// The self-calibrations' bounded blocks (range scale and offset, odometry
+// scales) are kept in their bounds as Ceres keeps them: the same steps.
+TEST(SlamSolverTest, BandedCholeskyMatchesCeresWithBoundedCalibrations) {
+  SimulationOptions sim = PaperOptions(23);
+  sim.num_landmarks = 4;
+  Dataset dataset;
+  std::string error;
+  ASSERT_TRUE(Simulate(sim, &dataset, &error)) << error;
+  SlamOptions options = WnoaWithoutLearning();
+  options.problem.range_calibration.estimate = true;
+  options.problem.odometry_calibration.estimate = true;
+  ExpectAutoTakesTheEnvelopeWithCeresSteps(dataset, options);
+}
+
 // The paper's protocol (300 poses, 50 landmarks seen from the whole run):
 // 5000 multiply-adds a variable in the envelope, but so few in all that
 // CHOLMOD's analysis costs more than the fill it saves. Auto takes the
@@ -809,16 +823,6 @@ INSTANTIATE_TEST_SUITE_P(
                   "--trust_region_strategy=DOGLEG: --linear_solver="
                   "BANDED_CHOLESKY runs Levenberg-Marquardt only; allowed "
                   "LEVENBERG_MARQUARDT with BANDED_CHOLESKY"},
-        BadOption{"BandedCholeskyWithBoundedCalibration",
-                  [](SlamOptions* o) {
-                    o->solver.linear_solver = "BANDED_CHOLESKY";
-                    o->problem.range_calibration.estimate = true;
-                  },
-                  "--linear_solver=BANDED_CHOLESKY: a parameter has bounds "
-                  "(the self-calibrations of --estimate_range_calibration, "
-                  "on where ranges are read as depths, and "
-                  "--estimate_odometry_calibration have); allowed auto or a "
-                  "Ceres linear solver"},
         BadOption{"CgnrWithSchurPreconditioner",
                   [](SlamOptions* o) {
                     o->solver.linear_solver = "CGNR";
