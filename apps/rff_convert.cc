@@ -11,6 +11,7 @@
 #include <gflags/gflags.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <map>
@@ -159,11 +160,15 @@ bool ConvertPlaza(const rff::PlazaOptions& options, rff::Dataset* dataset,
       "(%zu out of time order, sorted)\n",
       s.ground_truth_rows, s.odometry_rows, s.range_rows,
       s.ranges_out_of_order);
+  char measured[64] = "not measurable";
+  if (std::isfinite(s.measured_heading_offset)) {
+    std::snprintf(measured, sizeof(measured), "%.4f rad",
+                  s.measured_heading_offset);
+  }
   std::printf(
-      "heading offset: odometry frame = GT heading + %.4f rad (%s; measured "
-      "%.4f rad)\n",
-      s.heading_offset, s.heading_offset_source.c_str(),
-      s.measured_heading_offset);
+      "heading offset: odometry frame = GT heading + %.4f rad (%s; "
+      "measured: %s)\n",
+      s.heading_offset, s.heading_offset_source.c_str(), measured);
   std::printf(
       "calibration fit r_true ~ a * r + b: a = %.6f, b = %.6f m, inlier "
       "sigma = %.4f m, %zu inliers of %zu (threshold %g m)\n",

@@ -234,6 +234,13 @@ int main(int argc, char** argv) {
         "min_range", rff::FormatNumber(FLAGS_min_range),
         "applies with --sensor_range > 0 or --observe_nearest only"));
   }
+  // The view is part of the visibility model only.
+  if (Given("field_of_view_deg") && !(options.sensor_range > 0.0) &&
+      options.field_of_view < 2.0 * M_PI) {
+    return Fail(rff::OptionError("field_of_view_deg",
+                                 rff::FormatNumber(FLAGS_field_of_view_deg),
+                                 "applies with --sensor_range > 0 only"));
+  }
 
   rff::Dataset dataset;
   if (!rff::Simulate(options, &dataset, &error)) return Fail(error);

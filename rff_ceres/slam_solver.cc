@@ -134,6 +134,25 @@ bool CheckData(const Dataset& dataset, const SlamOptions& options,
       return false;
     }
   }
+  // A self-calibration needs records of the sensor it calibrates.
+  const bool ranges =
+      std::any_of(dataset.observations.begin(), dataset.observations.end(),
+                  [](const Observation& o) { return o.HasRange(); });
+  if (options.problem.range_calibration.estimate && !ranges) {
+    *error =
+        "--estimate_range_calibration: the dataset has no RANGE or "
+        "RANGE_BEARING records, no range to calibrate";
+    return false;
+  }
+  if (options.problem.odometry_calibration.estimate &&
+      (dataset.odometry.empty() || !options.problem.use_odometry)) {
+    *error = std::string("--estimate_odometry_calibration: ") +
+             (dataset.odometry.empty() ? "the dataset has no ODOM records"
+                                       : "--use_odometry=false leaves out "
+                                         "the ODOM records") +
+             ", no odometry to calibrate";
+    return false;
+  }
   // The prior's size limits over the data's times, before any solve: its
   // mean comes later, but the model's size does not depend on it.
   if (!CreateTrajectoryModel(dataset, options, UnitWindowMean(), error)) {

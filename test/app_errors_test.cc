@@ -323,6 +323,11 @@ const AppCase kAppCases[] = {
      "rff_simulate: error: --field_of_view_deg=5e-324: too small for radians "
      "in double precision; allowed more than 0 up to 360\n",
      "{dir}/s.rffd"},
+    {"SimulateFieldOfViewWithoutSensorRange",
+     "{bin}/rff_simulate --output={dir}/s.rffd --field_of_view_deg=10",
+     "rff_simulate: error: --field_of_view_deg=10: applies with "
+     "--sensor_range > 0 only\n",
+     "{dir}/s.rffd"},
     {"SimulateZeroFieldOfView",
      "{bin}/rff_simulate --output={dir}/s.rffd --field_of_view_deg=0",
      "rff_simulate: error: --field_of_view_deg=0: allowed more than 0 up to "

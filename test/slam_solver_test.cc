@@ -1241,6 +1241,39 @@ TEST(SlamSolverTest, CrowdedLandmarksKeepTheirCovariance) {
   EXPECT_EQ(result.pose_covariances.size(), result.trajectory.size());
 }
 
+// A self-calibration without records of its sensor is refused before any
+// solve, not reported at its prior.
+TEST(SlamSolverTest, ASelfCalibrationWithoutItsSensorIsAnError) {
+  SimulationOptions sim = PaperOptions(5);
+  sim.num_steps = 20;
+  sim.kind = ObservationType::kBearing;
+  Dataset bearings;
+  std::string error;
+  ASSERT_TRUE(Simulate(sim, &bearings, &error)) << error;
+  sim.kind = ObservationType::kRangeBearing;
+  sim.odometry = false;
+  Dataset without_odometry;
+  ASSERT_TRUE(Simulate(sim, &without_odometry, &error)) << error;
+  SlamResult result;
+  SlamOptions range = PaperSolverOptions();
+  range.problem.range_calibration.estimate = true;
+  EXPECT_FALSE(RunSlam(bearings, range, &result, &error));
+  EXPECT_EQ(error,
+            "--estimate_range_calibration: the dataset has no RANGE or "
+            "RANGE_BEARING records, no range to calibrate");
+  SlamOptions odometry = PaperSolverOptions();
+  odometry.problem.odometry_calibration.estimate = true;
+  EXPECT_FALSE(RunSlam(without_odometry, odometry, &result, &error));
+  EXPECT_EQ(error,
+            "--estimate_odometry_calibration: the dataset has no ODOM "
+            "records, no odometry to calibrate");
+  odometry.problem.use_odometry = false;
+  EXPECT_FALSE(RunSlam(bearings, odometry, &result, &error));
+  EXPECT_EQ(error,
+            "--estimate_odometry_calibration: --use_odometry=false leaves "
+            "out the ODOM records, no odometry to calibrate");
+}
+
 TEST(SlamSolverTest, NothingToEstimateIsAnError) {
   Dataset dataset;
   dataset.pose_priors.push_back({{0.0, 0.0, 0.0, 0.0}, 0.1, 0.1});

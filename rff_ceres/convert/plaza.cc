@@ -354,9 +354,10 @@ bool ResolveHeadingOffset(const std::string& prefix,
     summary->heading_offset_source =
         "measured, not declared (nearest multiple of pi/2)";
   } else {
-    summary->heading_offset = 0.0;
-    summary->heading_offset_source =
-        "none declared, not measurable from the data";
+    *error = dr_path + ": no " + std::string(kHeadingOffsetKey) +
+             " declared in the headers, and the ground truth moves too " +
+             "little to measure one; set --plaza_heading_offset";
+    return false;
   }
   if (std::isfinite(measured) &&
       std::abs(WrapAngle(measured - summary->heading_offset)) > tolerance) {

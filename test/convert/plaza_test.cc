@@ -541,6 +541,37 @@ TEST(PlazaHeadingOffsetTest, RejectsAnOffsetTheDataContradict) {
               HasSubstr("but the heading offset is 0 rad (option)"));
 }
 
+// A robot that stands still neither declares its heading offset nor lets
+// it be measured: the converter asks for it instead of assuming 0.
+TEST(PlazaHeadingOffsetTest, AnOffsetNeitherDeclaredNorMeasurableIsAnError) {
+  const std::string dir = TempDir();
+  std::ostringstream gt, dr, td;
+  for (int k = 0; k < 10; ++k) {
+    gt << k << " 3 -2 0.7\n";
+    if (k > 0) dr << k << " 0 0\n";
+    // Beacons 3 at (0, 10) and 4 at (10, 0) in turn: two distances to fit.
+    const double range =
+        k % 2 ? std::hypot(-7.0, -2.0) : std::hypot(3.0, -12.0);
+    td << k << " 2 " << 3 + k % 2 << " " << FormatNumber((range - kB) / kA)
+       << "\n";
+  }
+  WriteFile(dir + "/Rot_GT.txt", gt.str());
+  WriteFile(dir + "/Rot_DR.txt", dr.str());
+  WriteFile(dir + "/Rot_TL.txt", "3 0 10\n4 10 0\n");
+  WriteFile(dir + "/Rot_TD.txt", td.str());
+  Dataset d;
+  PlazaSummary s;
+  std::string error;
+  EXPECT_FALSE(ConvertRotated(dir, PlazaOptions(), &d, &s, &error));
+  EXPECT_EQ(error, dir +
+                       "/Rot_DR.txt: no init_heading_offset declared in the "
+                       "headers, and the ground truth moves too little to "
+                       "measure one; set --plaza_heading_offset");
+  PlazaOptions given;
+  given.heading_offset = 0.0;
+  EXPECT_TRUE(ConvertRotated(dir, given, &d, &s, &error)) << error;
+}
+
 TEST(PlazaHeadingOffsetTest, RejectsBadDeclarations) {
   const std::string dir = TempDir();
   EXPECT_EQ(
