@@ -212,9 +212,7 @@ bool RunSolve(const SolverOptions& solver, ceres::Solver::Options ceres_options,
     const BandedColumns columns = problem->BandColumns();
     std::string why;
     std::shared_ptr<BandedProblem> banded;
-    if (!BandedSolvable(*problem->problem(), columns, &why)) {
-      // `why` says it.
-    } else {
+    if (BandedSolvable(*problem->problem(), columns, &why)) {
       banded = problem->BandedLayout(columns);
       const BandedSize size = banded->Size();
       // The envelope three times: H, the candidate step's H and the
