@@ -23,10 +23,10 @@ DEFINE_double(landmark_prior_offset, 0.0,
               "every PRIOR_LANDMARK mean; their sigmas become at least this. "
               "0 leaves them unchanged. 0 to 1e6.");
 DEFINE_double(start_heading_offset_deg, 0.0,
-              "Rotation (degrees) of the earliest PRIOR_POSE's heading, -360 "
+              "Rotation (degrees) of the earliest PRIOR_POSEs' heading, -360 "
               "to 360.");
 DEFINE_double(start_heading_sigma, 0.0,
-              "New sigma_theta (rad) of the earliest PRIOR_POSE; unchanged "
+              "New sigma_theta (rad) of the earliest PRIOR_POSEs; unchanged "
               "unless given (pi: the start heading is unknown). More than 0 "
               "up to 1e6.");
 DEFINE_uint64(seed, 1, "Random seed; the same seed gives the same file.");

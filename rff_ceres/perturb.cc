@@ -59,22 +59,27 @@ void OffsetLandmarkPriors(const PerturbOptions& options, Dataset* dataset) {
                           offset_text);
 }
 
-// The earliest PRIOR_POSE (the first of equal times) is the start.
+// Every PRIOR_POSE at the earliest time is the start: one left as it was
+// would hold the start heading the perturbation turned.
 void RotateStartHeading(const PerturbOptions& options, Dataset* dataset) {
-  PosePrior& start = EarliestPosePrior(dataset);
-  const double old_theta = start.pose.theta;
-  const double old_sigma = start.sigma_theta;
-  start.pose.theta =
-      WrapAngle(old_theta + options.start_heading_offset_deg * kDegree);
-  if (options.start_heading_sigma) {
-    start.sigma_theta = *options.start_heading_sigma;
+  const double t0 = EarliestPosePrior(*dataset).pose.t;
+  std::string done;
+  for (PosePrior& start : dataset->pose_priors) {
+    if (start.pose.t != t0) continue;
+    const double old_theta = start.pose.theta;
+    const double old_sigma = start.sigma_theta;
+    start.pose.theta =
+        WrapAngle(old_theta + options.start_heading_offset_deg * kDegree);
+    if (options.start_heading_sigma) {
+      start.sigma_theta = *options.start_heading_sigma;
+    }
+    done += (done.empty() ? "" : "; ") + std::string("PRIOR_POSE at t=") +
+            FormatNumber(start.pose.t) + " theta " + FormatNumber(old_theta) +
+            " -> " + FormatNumber(start.pose.theta) + ", sigma_theta " +
+            FormatNumber(old_sigma) + " -> " + FormatNumber(start.sigma_theta);
   }
-  dataset->metadata.emplace_back(
-      "perturbation",
-      HeadingRequest(options) + ": PRIOR_POSE at t=" +
-          FormatNumber(start.pose.t) + " theta " + FormatNumber(old_theta) +
-          " -> " + FormatNumber(start.pose.theta) + ", sigma_theta " +
-          FormatNumber(old_sigma) + " -> " + FormatNumber(start.sigma_theta));
+  dataset->metadata.emplace_back("perturbation",
+                                 HeadingRequest(options) + ": " + done);
 }
 
 }  // namespace

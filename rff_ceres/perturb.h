@@ -20,10 +20,10 @@ struct PerturbOptions {
   // each axis of every PRIOR_LANDMARK mean; the prior's sigma becomes
   // max(sigma, offset), so that the prior stays honest. 0: unchanged.
   double landmark_prior_offset = 0.0;
-  // Rotation (degrees) of the earliest PRIOR_POSE's heading, wrapped to
-  // (-pi, pi] after it.
+  // Rotation (degrees) of the heading of every PRIOR_POSE at the earliest
+  // time, wrapped to (-pi, pi] after it.
   double start_heading_offset_deg = 0.0;
-  // New sigma_theta (rad) of that PRIOR_POSE; unset: unchanged. pi says
+  // New sigma_theta (rad) of those PRIOR_POSEs; unset: unchanged. pi says
   // "the start heading is unknown".
   std::optional<double> start_heading_sigma;
   // Seed of the landmark draws (SimulationRandom); the same seed gives the

@@ -173,6 +173,26 @@ TEST(PerturbTest, StartHeadingIsRotatedAndWrapped) {
   EXPECT_EQ(d.pose_priors[1].sigma_theta, 1.5);
 }
 
+// Two priors at the earliest time: both are the start, and both turn.
+TEST(PerturbTest, EveryPriorAtTheStartIsTurned) {
+  Dataset input = ManyPriors(1);
+  input.pose_priors.push_back({{0.0, 0.0, 0.0, -1.0}, 0.2, 0.05});
+  PerturbOptions options;
+  options.start_heading_offset_deg = 90.0;
+  const Dataset d = Perturbed(options, input);
+  EXPECT_NEAR(d.pose_priors[1].pose.theta, 3.0 + M_PI / 2.0 - 2.0 * M_PI,
+              1e-15);
+  EXPECT_NEAR(d.pose_priors[2].pose.theta, -1.0 + M_PI / 2.0, 1e-15);
+  EXPECT_EQ(d.pose_priors[0].pose.theta, 1.0);
+  EXPECT_EQ(d.metadata.back().second,
+            "start_heading_offset_deg=90 seed=1: PRIOR_POSE at t=0 theta 3 "
+            "-> " +
+                FormatNumber(d.pose_priors[1].pose.theta) +
+                ", sigma_theta 0.01 -> 0.01; PRIOR_POSE at t=0 theta -1 -> " +
+                FormatNumber(d.pose_priors[2].pose.theta) +
+                ", sigma_theta 0.05 -> 0.05");
+}
+
 TEST(PerturbTest, SameSeedGivesIdenticalOutputAndAnotherSeedDiffers) {
   const Dataset input = ManyPriors(20);
   PerturbOptions options;
