@@ -408,19 +408,17 @@ bool RunSlamAtOrigin(const Dataset& dataset, const SlamOptions& options,
   } else {
     // Judged at a minimum only: the residuals of a solve cut short may
     // follow any regressor.
-    const bool range_bearing =
+    const bool to_read =
+        settled.problem.range_bearing_ranges == "auto" &&
         std::any_of(dataset.observations.begin(), dataset.observations.end(),
                     [](const Observation& o) {
                       return o.type == ObservationType::kRangeBearing;
                     });
-    if (!range_bearing) {
-      // Nothing to read.
-    } else if (settled.problem.range_bearing_ranges == "auto" &&
-               result->summary.termination_type != ceres::CONVERGENCE) {
+    if (to_read && result->summary.termination_type != ceres::CONVERGENCE) {
       result->range_reading_note = "auto not judged: the first solve ended " +
                                    std::string(ceres::TerminationTypeToString(
                                        result->summary.termination_type));
-    } else if (settled.problem.range_bearing_ranges == "auto") {
+    } else if (to_read) {
       result->depth_evidence = MeasureDepthEvidence(
           resolved, [&](double t) { return model->Pose(t); }, landmarks);
       result->range_reading_judged = true;
