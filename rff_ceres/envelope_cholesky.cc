@@ -302,6 +302,12 @@ bool EnvelopeMatrix::InvertOnEnvelope(double* rcond, double min_rcond) {
   return bound > min_rcond;
 }
 
+double EnvelopeMatrix::LogDeterminant() const {
+  double sum = 0.0;
+  for (int i = 0; i < size(); ++i) sum += std::log((*this)(i, i));
+  return 2.0 * sum;
+}
+
 Eigen::VectorXd EnvelopeMatrix::Solve(const Eigen::VectorXd& b) const {
   return SolveUpper(SolveLower(b));
 }

@@ -57,6 +57,8 @@ class EnvelopeMatrix {
   // `lower`, also replaces it by L^-1 lower, each row of L used as it is
   // formed (SolveLower's arithmetic, without a pass of its own over L).
   bool Factorize(Eigen::VectorXd* lower = nullptr);
+  // log det A with the factor of Factorize: 2 sum_i log L_ii.
+  double LogDeterminant() const;
   // A^-1 b with the factor of Factorize: L^-T (L^-1 b), each half apart.
   Eigen::VectorXd Solve(const Eigen::VectorXd& b) const;
   Eigen::VectorXd SolveLower(const Eigen::VectorXd& b) const;

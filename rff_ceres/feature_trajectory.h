@@ -127,6 +127,7 @@ class FeatureTrajectory : public TrajectoryModel {
   // theta with the heading kernel's.
   std::vector<PriorScale> PriorRowScales(const std::vector<double*>& blocks,
                                          int num_rows) const override;
+  bool PriorScalesWhitenRows() const override { return false; }
 
   // The options with the capacity settled (see AutoCapacity), of the longest
   // stretch where each settles its own.

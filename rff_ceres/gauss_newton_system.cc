@@ -463,6 +463,17 @@ Eigen::VectorXd GaussNewtonSystem::ApplyCInverse(
   return out;
 }
 
+double GaussNewtonSystem::LogDeterminant() const {
+  CHECK(positive_definite_);
+  if (envelope_ != nullptr) return envelope_->LogDeterminant();
+  if (!structured_) return sparse_->vectorD().array().log().sum();
+  double sum = schur_.vectorD().array().log().sum();
+  for (const Eigen::Matrix2d& c_inverse : c_inverse_) {
+    sum -= std::log(c_inverse.determinant());
+  }
+  return sum;
+}
+
 Eigen::MatrixXd GaussNewtonSystem::Solve(const Eigen::MatrixXd& z) const {
   if (envelope_ != nullptr) {
     EnvelopeMatrix::RowMajorMatrix x(z.rows(), z.cols());

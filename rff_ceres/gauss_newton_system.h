@@ -104,6 +104,9 @@ class GaussNewtonSystem {
   // H^-1 z, every column of z at once: the sparse factor is read once for
   // all of them, with the same arithmetic as one column at a time.
   Eigen::MatrixXd Solve(const Eigen::MatrixXd& z) const;
+  // log det H (positive definite only): the envelope's, det C det S of the
+  // Schur form (C the landmarks' blocks), or the sparse LDLT's pivots.
+  double LogDeterminant() const;
   // Structured only: S^-1, the covariance of the leading t parameters.
   Eigen::MatrixXd LeadingCovariance() const;
   // Structured only: the 2x2 covariance of every landmark.

@@ -68,6 +68,9 @@ class MeanRotationTrajectory : public TrajectoryModel {
     }
     return inner_->PriorRowScales(blocks, num_rows);
   }
+  bool PriorScalesWhitenRows() const override {
+    return inner_->PriorScalesWhitenRows();
+  }
   void set_mean(std::shared_ptr<const MeanFunction> mean) override;
   // The rotation's prior has no scale; the inner model's costs follow it.
   void UpdatePriorCosts(

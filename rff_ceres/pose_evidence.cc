@@ -56,6 +56,7 @@ class PoseSamples : public TrajectoryModel {
                                          int num_rows) const override {
     return std::vector<PriorScale>(num_rows, PriorScale::kNone);
   }
+  bool PriorScalesWhitenRows() const override { return false; }
 
  private:
   std::vector<double> times_;

@@ -1,6 +1,7 @@
 #include "rff_ceres/scale_learning.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <initializer_list>
 #include <limits>
@@ -31,6 +32,28 @@ constexpr int kAcceleratingFalls = 3;
 // Noise sigmas stay within this factor of the stated ones: noise-free data
 // would drive them to 0 and the system to no digits.
 constexpr double kMaxNoiseScale = 1e3;
+
+// log s_g of every group's rows as the problem whitens them
+// (LaplaceLogEvidence): the prior's scales where they divide its rows, the
+// squares of the noise factors.
+std::array<double, kNumVarianceGroups> LogRowScales(
+    const TrajectoryModel& model, double position_scale, double heading_scale,
+    const NoiseScales& noise) {
+  std::array<double, kNumVarianceGroups> log_scales{};
+  if (model.PriorScalesWhitenRows()) {
+    log_scales[static_cast<int>(VarianceGroup::kPriorPosition)] =
+        std::log(position_scale);
+    log_scales[static_cast<int>(VarianceGroup::kPriorHeading)] =
+        std::log(heading_scale);
+  }
+  for (const VarianceGroup group :
+       {VarianceGroup::kRange, VarianceGroup::kBearing,
+        VarianceGroup::kOdometry}) {
+    log_scales[static_cast<int>(group)] =
+        2.0 * std::log(NoiseScale(noise, group));
+  }
+  return log_scales;
+}
 
 // Whether either loss is still to be judged.
 bool HasAutoLoss(const ProblemOptions& options) {
@@ -117,6 +140,15 @@ bool LearnScales(const Dataset& dataset,
     }
   };
   note_radius();
+  // The scales the last round solved with, its evidence, and whether the
+  // rounds have climbed it.
+  struct Solved {
+    double position, heading;
+    NoiseScales noise;
+    double log_evidence;
+  };
+  Solved last{};
+  bool climbed = false;
   for (int round = 0; round < kMaxScaleRounds; ++round) {
     VarianceComponents components;
     std::string why;
@@ -127,6 +159,17 @@ bool LearnScales(const Dataset& dataset,
       result->scales_not_learned = why;
       break;
     }
+    const double log_evidence = LaplaceLogEvidence(
+        components,
+        LogRowScales(**model, *position_scale, *heading_scale, sigmas));
+    result->scale_log_evidence.push_back(log_evidence);
+    // Near their fixed point the rounds climb the evidence. Once they have,
+    // a fall means a round overshot, or the probes' noise in a weakly
+    // determined redundancy walks a sigma downhill: back to the scales of
+    // the round before, and the final solve.
+    const bool evidence_fell = climbed && log_evidence < last.log_evidence;
+    climbed = climbed || (round > 0 && log_evidence > last.log_evidence);
+    const Solved solved{*position_scale, *heading_scale, sigmas, log_evidence};
     double largest_step = 0.0;
     const std::size_t boundary_before = at_boundary.size();
     const double position_solved = *position_scale;
@@ -175,13 +218,21 @@ bool LearnScales(const Dataset& dataset,
         learned.insert(group);
       }
     };
-    rescale(VarianceGroup::kPriorPosition, 1.0, position_scale);
-    rescale(VarianceGroup::kPriorHeading, 1.0, heading_scale);
-    if (noise) {
-      rescale(VarianceGroup::kRange, 0.5, &sigmas.range);
-      rescale(VarianceGroup::kBearing, 0.5, &sigmas.bearing);
-      rescale(VarianceGroup::kOdometry, 0.5, &sigmas.odometry);
+    if (evidence_fell) {
+      *position_scale = last.position;
+      *heading_scale = last.heading;
+      sigmas = last.noise;
+      result->learning_evidence_fell = true;
+    } else {
+      rescale(VarianceGroup::kPriorPosition, 1.0, position_scale);
+      rescale(VarianceGroup::kPriorHeading, 1.0, heading_scale);
+      if (noise) {
+        rescale(VarianceGroup::kRange, 0.5, &sigmas.range);
+        rescale(VarianceGroup::kBearing, 0.5, &sigmas.bearing);
+        rescale(VarianceGroup::kOdometry, 0.5, &sigmas.odometry);
+      }
     }
+    last = solved;
     VLOG(1)
         << "scale round " << round << ": prior position factor "
         << components[static_cast<int>(VarianceGroup::kPriorPosition)].factor
@@ -199,7 +250,8 @@ bool LearnScales(const Dataset& dataset,
         << components[static_cast<int>(VarianceGroup::kPriorPosition)].factor,
         components[static_cast<int>(VarianceGroup::kPriorHeading)].factor;
     // Every factor but those stepping to the boundary within tolerance.
-    const bool others_settled = largest_step < std::log1p(kScaleTolerance);
+    const bool others_settled =
+        !evidence_fell && largest_step < std::log1p(kScaleTolerance);
     const bool boundary_step = at_boundary.size() > boundary_before;
     if (others_settled && !boundary_step) {
       // Within tolerance: the prior keeps the scales it was solved with, so
@@ -238,12 +290,12 @@ bool LearnScales(const Dataset& dataset,
     rounds_solved = true;
     result->learned = true;
     loose = true;
-    if (others_settled) {
-      // Only a boundary step left: the final solve takes it, on a problem
-      // built anew where the features followed the variance (the old one
-      // holds costs of the model replaced).
+    if (others_settled || evidence_fell) {
+      // Only a boundary step, or the way back, left: the final solve takes
+      // it, on a problem built anew where the features followed the
+      // variance (the old one holds costs of the model replaced).
       if (!in_place) problem->reset();
-      result->learning_converged = true;
+      result->learning_converged = others_settled;
       break;
     }
     if (!SolveBatch(dataset, *settled, placing_options, model->get(), landmarks,

@@ -39,6 +39,15 @@ std::string JsonStringArray(const std::vector<std::string>& items) {
   return out + "]";
 }
 
+// [-4678.9, -4645.1, ...]
+std::string NumberList(const std::vector<double>& numbers) {
+  std::string out = "[";
+  for (std::size_t i = 0; i < numbers.size(); ++i) {
+    out += (i == 0 ? "" : ", ") + FormatNumber(numbers[i]);
+  }
+  return out + "]";
+}
+
 // [{"kind": "range", "batches": 271, "ratio": 9.7, "drifts": true}, ...]
 std::string DriftJson(const std::vector<ResidualDrift>& drifts) {
   std::string out = "[";
@@ -64,8 +73,9 @@ void PrintSlamSummary(const SlamOptions& options, const SlamResult& result,
     *out << "  scales       " << prior.scales_name()
          << " learned by variance components, " << result.learning_rounds
          << (result.learning_rounds == 1 ? " round" : " rounds")
-         << (result.learning_converged
-                 ? ""
+         << (result.learning_converged ? ""
+             : result.learning_evidence_fell
+                 ? " (ended at the round before the Laplace evidence fell)"
                  : " (stopped at the round cap, the factors still moving)");
     const char* separator = "; at zero, the data leave no variance to: ";
     for (const std::string& group : result.scales_at_boundary) {
@@ -224,6 +234,10 @@ void WriteSummaryJson(const SlamOptions& options, const SlamResult& result,
       << "  \"learning_rounds\": " << result.learning_rounds << ",\n"
       << "  \"learning_converged\": "
       << (result.learning_converged ? "true" : "false") << ",\n"
+      << "  \"learning_evidence_fell\": "
+      << (result.learning_evidence_fell ? "true" : "false") << ",\n"
+      << "  \"scale_log_evidence\": " << NumberList(result.scale_log_evidence)
+      << ",\n"
       << "  \"scales_not_learned\": " << JsonString(result.scales_not_learned)
       << ",\n"
       << "  \"prior_scale_factors\": ["

@@ -68,6 +68,10 @@ struct SlamResult {
   int learning_rounds = 0;
   // The last round's factors were all within 10% of 1 (not the round cap).
   bool learning_converged = false;
+  // The Laplace log evidence (variance_components.h) at each round's MAP,
+  // and whether the rounds ended at the scales of the round before a fall.
+  std::vector<double> scale_log_evidence;
+  bool learning_evidence_fell = false;
   // Groups of a correction's variances the data leave at zero (their factor
   // under 0.01): learned by one step down, no further rounds.
   std::vector<std::string> scales_at_boundary;

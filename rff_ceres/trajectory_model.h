@@ -52,6 +52,11 @@ class TrajectoryModel {
   enum class PriorScale { kNone, kPosition, kHeading };
   virtual std::vector<PriorScale> PriorRowScales(
       const std::vector<double*>& blocks, int num_rows) const = 0;
+  // Whether a scale divides the prior rows it owns (WNOA: Q_c whitens the
+  // increments) rather than living in the map from blocks to poses (feature
+  // weights: b ~ N(0, I), the kernel's variance in the features). The
+  // Laplace evidence counts n log s for the rows a scale divides.
+  virtual bool PriorScalesWhitenRows() const = 0;
 
   // Whether the reduced system (landmarks eliminated) is dense for this
   // model's structure: global feature maps are, Markov states (banded)

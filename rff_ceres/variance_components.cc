@@ -116,7 +116,8 @@ bool BandedTraces(SlamProblem* problem, const std::vector<double*>& ll_columns,
                   const std::vector<VarianceGroup>& groups,
                   const VarianceComponentOptions& options,
                   VarianceComponentCache* cache, Eigen::VectorXd* residuals,
-                  std::array<double, kNumVarianceGroups>* traces) {
+                  std::array<double, kNumVarianceGroups>* traces,
+                  double* log_det) {
   BandedSystem system;
   if (!FactorizeBanded(problem, &system)) return false;
   BandedProblem& banded = *system.banded;
@@ -152,6 +153,7 @@ bool BandedTraces(SlamProblem* problem, const std::vector<double*>& ll_columns,
     }
   }
   *traces = sums;
+  *log_det = hessian.LogDeterminant();
   return true;
 }
 
@@ -164,7 +166,7 @@ bool SparseTraces(SlamProblem* problem, const std::vector<double*>& columns,
                   const VarianceComponentOptions& options,
                   VarianceComponentCache* cache, Eigen::VectorXd* residuals,
                   std::array<double, kNumVarianceGroups>* traces,
-                  std::string* error) {
+                  double* log_det, std::string* error) {
   double cost = 0.0;
   Eigen::SparseMatrix<double, Eigen::RowMajor> jacobian;
   if (!Linearize(problem->problem(), ids, &cost, residuals, &jacobian, error,
@@ -184,6 +186,7 @@ bool SparseTraces(SlamProblem* problem, const std::vector<double*>& columns,
     *error = "the Gauss-Newton Hessian is not positive definite";
     return false;
   }
+  *log_det = hessian.LogDeterminant();
   // Probes in batches: one pass over J and the factor per batch.
   const int per_pass = ProbesPerPass(jacobian.rows(), 8);
   const std::vector<signed char>& signs =
@@ -221,10 +224,12 @@ bool EstimateVarianceComponents(SlamProblem* problem,
   const std::vector<double*> columns = LandmarksLast(problem, &num_leading);
   std::array<double, kNumVarianceGroups> traces{};
   Eigen::VectorXd residuals;
+  double* log_det = &components->log_det_hessian;
   const bool banded = BandedTraces(problem, columns, groups, options, cache,
-                                   &residuals, &traces);
+                                   &residuals, &traces, log_det);
   if (!banded && !SparseTraces(problem, columns, num_leading, ids, groups,
-                               options, cache, &residuals, &traces, error)) {
+                               options, cache, &residuals, &traces, log_det,
+                               error)) {
     return false;
   }
   for (Eigen::Index r = 0; r < residuals.size(); ++r) {
@@ -242,6 +247,16 @@ bool EstimateVarianceComponents(SlamProblem* problem,
     }
   }
   return true;
+}
+
+double LaplaceLogEvidence(
+    const VarianceComponents& components,
+    const std::array<double, kNumVarianceGroups>& log_row_scales) {
+  double sum = components.log_det_hessian;
+  for (int g = 0; g < kNumVarianceGroups; ++g) {
+    sum += components[g].sum_squares + components[g].rows * log_row_scales[g];
+  }
+  return -0.5 * sum;
 }
 
 }  // namespace rff

@@ -45,7 +45,32 @@ struct VarianceComponentOptions {
   double min_redundancy = 10.0;
 };
 
-using VarianceComponents = std::array<VarianceComponent, kNumVarianceGroups>;
+struct VarianceComponents {
+  std::array<VarianceComponent, kNumVarianceGroups> groups;
+  // log det H, from the factorisation the traces use.
+  double log_det_hessian = 0.0;
+
+  VarianceComponent& operator[](int group) { return groups[group]; }
+  const VarianceComponent& operator[](int group) const {
+    return groups[group];
+  }
+  auto begin() const { return groups.begin(); }
+  auto end() const { return groups.end(); }
+};
+
+// The Laplace approximation of the log evidence at the MAP the components
+// were estimated at, up to a constant no scale changes (MacKay 1992):
+//
+//   log Z = -1/2 sum_g (r_g^T r_g + n_g log s_g) - 1/2 log det H,
+//
+// s_g the variance factor the rows of group g are whitened with
+// (`log_row_scales`, log s_g; 0 where a scale is not on the rows, such as
+// feature weights whose kernel variance lives in the features). Its
+// stationary points in s_g are the fixed points s_g = r_g^T r_g /
+// redundancy_g above, the derivative of log det H giving the trace.
+double LaplaceLogEvidence(
+    const VarianceComponents& components,
+    const std::array<double, kNumVarianceGroups>& log_row_scales);
 
 // What calls on problems of one structure (a learning's rounds) share: the
 // sparse factorisation's analysis, and the probes, which depend only on the

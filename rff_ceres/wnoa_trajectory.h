@@ -90,6 +90,7 @@ class WnoaTrajectory : public TrajectoryModel {
   // ...); the initial-state prior has a fixed scale.
   std::vector<PriorScale> PriorRowScales(const std::vector<double*>& blocks,
                                          int num_rows) const override;
+  bool PriorScalesWhitenRows() const override { return true; }
 
   const std::vector<double>& state_times() const;
 

@@ -62,6 +62,7 @@ class LineTrajectory : public TrajectoryModel {
                                                  ? PriorScale::kHeading
                                                  : PriorScale::kPosition);
   }
+  bool PriorScalesWhitenRows() const override { return false; }
 
  private:
   std::shared_ptr<const MeanFunction> mean_;
