@@ -29,13 +29,27 @@ constexpr int kMaxScaleRounds = 12;
 constexpr double kScaleTolerance = 0.1;
 constexpr double kMaxScaleStep = 10.0;  // Per round, either way.
 constexpr int kAcceleratingFalls = 3;
+// Evidence that moves by less than this fraction of its size has stopped
+// (a plateau where the sigmas sit at their bound): a change of rounding.
+constexpr double kEvidenceRounding = 1e-9;
 // Noise sigmas stay within this factor of the stated ones: noise-free data
 // would drive them to 0 and the system to no digits.
 constexpr double kMaxNoiseScale = 1e3;
 
-// log s_g of every group's rows as the problem whitens them
-// (LaplaceLogEvidence): the prior's scales where they divide its rows, the
-// squares of the noise factors.
+// Whether either loss is still to be judged.
+bool HasAutoLoss(const ProblemOptions& options) {
+  return options.loss.name == "auto" || options.odometry_loss.name == "auto";
+}
+
+// `ceres_options` stopped at kPlacingTolerance at the latest.
+ceres::Solver::Options PlacingOptions(ceres::Solver::Options ceres_options) {
+  ceres_options.function_tolerance =
+      std::max(ceres_options.function_tolerance, kPlacingTolerance);
+  return ceres_options;
+}
+
+}  // namespace
+
 std::array<double, kNumVarianceGroups> LogRowScales(
     const TrajectoryModel& model, double position_scale, double heading_scale,
     const NoiseScales& noise) {
@@ -54,20 +68,6 @@ std::array<double, kNumVarianceGroups> LogRowScales(
   }
   return log_scales;
 }
-
-// Whether either loss is still to be judged.
-bool HasAutoLoss(const ProblemOptions& options) {
-  return options.loss.name == "auto" || options.odometry_loss.name == "auto";
-}
-
-// `ceres_options` stopped at kPlacingTolerance at the latest.
-ceres::Solver::Options PlacingOptions(ceres::Solver::Options ceres_options) {
-  ceres_options.function_tolerance =
-      std::max(ceres_options.function_tolerance, kPlacingTolerance);
-  return ceres_options;
-}
-
-}  // namespace
 
 ceres::Solver::Options JudgingOptions(const ProblemOptions& options,
                                       ceres::Solver::Options ceres_options) {
@@ -167,7 +167,10 @@ bool LearnScales(const Dataset& dataset,
     // a fall means a round overshot, or the probes' noise in a weakly
     // determined redundancy walks a sigma downhill: back to the scales of
     // the round before, and the final solve.
-    const bool evidence_fell = climbed && log_evidence < last.log_evidence;
+    const double rounding =
+        kEvidenceRounding * std::max(1.0, std::abs(last.log_evidence));
+    const bool evidence_fell =
+        climbed && log_evidence < last.log_evidence - rounding;
     climbed = climbed || (round > 0 && log_evidence > last.log_evidence);
     const Solved solved{*position_scale, *heading_scale, sigmas, log_evidence};
     double largest_step = 0.0;
@@ -224,6 +227,7 @@ bool LearnScales(const Dataset& dataset,
       sigmas = last.noise;
       result->learning_evidence_fell = true;
     } else {
+      const std::size_t kept_before = kept.size();
       rescale(VarianceGroup::kPriorPosition, 1.0, position_scale);
       rescale(VarianceGroup::kPriorHeading, 1.0, heading_scale);
       if (noise) {
@@ -231,6 +235,9 @@ bool LearnScales(const Dataset& dataset,
         rescale(VarianceGroup::kBearing, 0.5, &sigmas.bearing);
         rescale(VarianceGroup::kOdometry, 0.5, &sigmas.odometry);
       }
+      // A sigma sent back to the stated one is a jump, not a step of the
+      // climb: the next one starts from there.
+      if (kept.size() > kept_before) climbed = false;
     }
     last = solved;
     VLOG(1)

@@ -4,6 +4,7 @@
 #ifndef RFF_CERES_SCALE_LEARNING_H_
 #define RFF_CERES_SCALE_LEARNING_H_
 
+#include <array>
 #include <map>
 #include <memory>
 #include <string>
@@ -29,6 +30,13 @@ ceres::Solver::Options JudgingOptions(const ProblemOptions& options,
 // outlier level of their count becomes "none", the rest "cauchy". Returns
 // whether any was "auto", so that the judging solve is to be finished.
 bool SettleAutoLosses(SlamProblem* problem, ProblemOptions* options);
+
+// log s_g of every group's rows as a problem over `model` whitens them at
+// these scales (LaplaceLogEvidence): the prior's scales where they divide
+// its rows, the squares of the noise factors, 0 for the fixed rows.
+std::array<double, kNumVarianceGroups> LogRowScales(
+    const TrajectoryModel& model, double position_scale, double heading_scale,
+    const NoiseScales& noise);
 
 // Learns the scales of the trajectory prior (WNOA Q_c, RFF kernel
 // variances) of x, y and theta and, where `noise`, the factors on the sigmas

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <memory>
+#include <numeric>
 #include <random>
 #include <string>
 #include <vector>
@@ -58,6 +59,29 @@ TEST(GaussNewtonSystemTest, EveryFactorizationSolvesTheSameSystem) {
   const double scale = expected.cwiseAbs().maxCoeff();
   EXPECT_LT((schur.Solve(z) - expected).cwiseAbs().maxCoeff(), 1e-9 * scale);
   EXPECT_LT((sparse.Solve(z) - expected).cwiseAbs().maxCoeff(), 1e-9 * scale);
+}
+
+// Every factorisation gives log det H of the dense LDLT: the Schur form as
+// det C det S, the sparse LDLT's pivots, the envelope's diagonal.
+TEST(GaussNewtonSystemTest, EveryFactorizationGivesTheLogDeterminant) {
+  const int t = 40, landmarks = 3;
+  const RowMajorSparse jacobian = ChainWithLandmarks(t, landmarks, 7);
+  std::vector<int> time_order(t + 2 * landmarks);
+  std::iota(time_order.begin(), time_order.end(), 0);
+  const GaussNewtonSystem schur(jacobian, t, Factorization::kSchurOnly);
+  const GaussNewtonSystem sparse(jacobian, t, Factorization::kSparse);
+  const GaussNewtonSystem envelope(
+      jacobian, t, Factorization::kEnvelopeOrSparse, nullptr, time_order);
+  ASSERT_TRUE(schur.structured());
+  ASSERT_FALSE(sparse.structured());
+  ASSERT_TRUE(envelope.envelope());
+  const Eigen::MatrixXd h = Eigen::MatrixXd(
+      Eigen::SparseMatrix<double>(jacobian.transpose()) * jacobian);
+  const double expected = h.ldlt().vectorD().array().log().sum();
+  EXPECT_GT(std::abs(expected), 1.0);
+  for (const GaussNewtonSystem* system : {&schur, &sparse, &envelope}) {
+    EXPECT_NEAR(system->LogDeterminant(), expected, 1e-9 * std::abs(expected));
+  }
 }
 
 // Rows over separate runs of leading columns (two windows' features, as
@@ -548,6 +572,8 @@ TEST(FactorizeBandedTest, FeatureWindowsSolvedBandedLeaveTheirH) {
     EXPECT_NEAR(a.redundancy, b.redundancy, 1e-9 * (1.0 + b.rows)) << group;
     estimated += b.estimated;
   }
+  EXPECT_NEAR(banded.log_det_hessian, through_sparse.log_det_hessian,
+              1e-9 * std::abs(through_sparse.log_det_hessian));
   EXPECT_GE(estimated, 2);
 }
 
