@@ -140,14 +140,21 @@ bool LearnScales(const Dataset& dataset,
     }
   };
   note_radius();
-  // The scales the last round solved with, its evidence, and whether the
-  // rounds have climbed it.
+  // The evidence is the Gaussian rows' (LaplaceLogEvidence). Under a robust
+  // loss the rounds rescale the loss-corrected residuals, whose fixed point
+  // is no stationary point of it: it guards nothing there.
+  const bool gaussian = settled->problem.loss.name == "none" &&
+                        settled->problem.odometry_loss.name == "none";
+  // What the last round solved with (its scales, the groups then at their
+  // boundary, its factors) and its evidence; whether the rounds climbed.
   struct Solved {
-    double position, heading;
+    double position = 0.0, heading = 0.0;
     NoiseScales noise;
-    double log_evidence;
+    std::set<VarianceGroup> at_boundary;
+    Eigen::Vector2d prior_factors = Eigen::Vector2d::Ones();
+    double log_evidence = 0.0;
   };
-  Solved last{};
+  Solved last;
   bool climbed = false;
   for (int round = 0; round < kMaxScaleRounds; ++round) {
     VarianceComponents components;
@@ -159,20 +166,28 @@ bool LearnScales(const Dataset& dataset,
       result->scales_not_learned = why;
       break;
     }
-    const double log_evidence = LaplaceLogEvidence(
-        components,
-        LogRowScales(**model, *position_scale, *heading_scale, sigmas));
-    result->scale_log_evidence.push_back(log_evidence);
+    const Eigen::Vector2d prior_factors(
+        components[static_cast<int>(VarianceGroup::kPriorPosition)].factor,
+        components[static_cast<int>(VarianceGroup::kPriorHeading)].factor);
+    const Solved solved{
+        *position_scale,
+        *heading_scale,
+        sigmas,
+        at_boundary,
+        prior_factors,
+        LaplaceLogEvidence(components, LogRowScales(**model, *position_scale,
+                                                    *heading_scale, sigmas))};
+    if (gaussian) result->scale_log_evidence.push_back(solved.log_evidence);
     // Near their fixed point the rounds climb the evidence. Once they have,
     // a fall means a round overshot, or the probes' noise in a weakly
-    // determined redundancy walks a sigma downhill: back to the scales of
-    // the round before, and the final solve.
+    // determined redundancy walks a sigma downhill: back to what the round
+    // before solved with, and the final solve.
     const double rounding =
         kEvidenceRounding * std::max(1.0, std::abs(last.log_evidence));
     const bool evidence_fell =
-        climbed && log_evidence < last.log_evidence - rounding;
-    climbed = climbed || (round > 0 && log_evidence > last.log_evidence);
-    const Solved solved{*position_scale, *heading_scale, sigmas, log_evidence};
+        gaussian && climbed &&
+        solved.log_evidence < last.log_evidence - rounding;
+    climbed = climbed || (round > 0 && solved.log_evidence > last.log_evidence);
     double largest_step = 0.0;
     const std::size_t boundary_before = at_boundary.size();
     const double position_solved = *position_scale;
@@ -225,7 +240,13 @@ bool LearnScales(const Dataset& dataset,
       *position_scale = last.position;
       *heading_scale = last.heading;
       sigmas = last.noise;
+      at_boundary = last.at_boundary;
+      result->scales_at_boundary.clear();
+      for (const VarianceGroup group : at_boundary) {
+        result->scales_at_boundary.push_back(VarianceGroupName(group));
+      }
       result->learning_evidence_fell = true;
+      result->noise_evidence_fell = noise;
     } else {
       const std::size_t kept_before = kept.size();
       rescale(VarianceGroup::kPriorPosition, 1.0, position_scale);
@@ -253,9 +274,8 @@ bool LearnScales(const Dataset& dataset,
         << "); sigma factors range " << sigmas.range << ", bearing "
         << sigmas.bearing << ", odometry " << sigmas.odometry;
     result->learning_rounds = round + 1;
-    result->prior_scale_factors
-        << components[static_cast<int>(VarianceGroup::kPriorPosition)].factor,
-        components[static_cast<int>(VarianceGroup::kPriorHeading)].factor;
+    result->prior_scale_factors =
+        evidence_fell ? last.prior_factors : prior_factors;
     // Every factor but those stepping to the boundary within tolerance.
     const bool others_settled =
         !evidence_fell && largest_step < std::log1p(kScaleTolerance);
@@ -311,9 +331,17 @@ bool LearnScales(const Dataset& dataset,
     }
     note_radius();
   }
+  const bool capped = result->learning_rounds == kMaxScaleRounds &&
+                      !result->learning_converged &&
+                      !result->learning_evidence_fell;
   for (const VarianceGroup group : learned) {
-    if (kept.count(group) == 0) {
-      result->noise_learned.push_back(VarianceGroupName(group));
+    if (kept.count(group) > 0) continue;
+    result->noise_learned.push_back(VarianceGroupName(group));
+    // Still falling at the cap while the evidence climbs: the sigma, and
+    // the covariances that follow it, sit where the cap stopped them.
+    if (capped && falls[group].last > std::log1p(kScaleTolerance) &&
+        NoiseScale(sigmas, group) > 1.0 / kMaxNoiseScale) {
+      result->noise_unsettled.push_back(VarianceGroupName(group));
     }
   }
   // The rounds' solves only placed the next factors.

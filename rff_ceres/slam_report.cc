@@ -106,6 +106,17 @@ void PrintSlamSummary(const SlamOptions& options, const SlamResult& result,
          << " times as much as white errors' (the covariances assume white "
             "errors)\n";
   }
+  if (options.output.covariance) {
+    for (const std::string& kind : result.noise_unsettled) {
+      *out << "  covariance   optimistic: the " << kind
+           << " sigma was still falling when the learning rounds reached "
+              "their cap ("
+           << NoiseScale(result.noise, DataRowGroup(kind, 0))
+           << " of the stated one): the evidence keeps rewarding a closer "
+              "fit of these rows, so the sigma, and the covariances that "
+              "follow it, sit where the rounds stopped\n";
+    }
+  }
   if (!result.noise_learned.empty()) {
     *out << "  noise        sigmas learned as the stated ones times:";
     const char* separator = " ";
@@ -113,6 +124,11 @@ void PrintSlamSummary(const SlamOptions& options, const SlamResult& result,
       *out << separator << kind << " "
            << NoiseScale(result.noise, DataRowGroup(kind, 0));
       separator = ", ";
+    }
+    // The RFF prior's sigmas come from its WNOA mean's rounds.
+    if (result.noise_evidence_fell && !result.learning_evidence_fell) {
+      *out << " (the WNOA mean's rounds ended at the round before the "
+              "Laplace evidence fell)";
     }
     *out << "\n";
   }
@@ -237,6 +253,10 @@ void WriteSummaryJson(const SlamOptions& options, const SlamResult& result,
       << "  \"learning_evidence_fell\": "
       << (result.learning_evidence_fell ? "true" : "false") << ",\n"
       << "  \"scale_log_evidence\": " << NumberList(result.scale_log_evidence)
+      << ",\n"
+      << "  \"noise_evidence_fell\": "
+      << (result.noise_evidence_fell ? "true" : "false") << ",\n"
+      << "  \"noise_unsettled\": " << JsonStringArray(result.noise_unsettled)
       << ",\n"
       << "  \"scales_not_learned\": " << JsonString(result.scales_not_learned)
       << ",\n"

@@ -70,8 +70,15 @@ struct SlamResult {
   bool learning_converged = false;
   // The Laplace log evidence (variance_components.h) at each round's MAP,
   // and whether the rounds ended at the scales of the round before a fall.
+  // Empty under a robust loss, where it guards nothing.
   std::vector<double> scale_log_evidence;
   bool learning_evidence_fell = false;
+  // The rounds that learned the noise sigmas (the WNOA mean's, for an RFF
+  // prior about one) ended so.
+  bool noise_evidence_fell = false;
+  // Noise kinds whose sigma was still falling by more than 10% a round when
+  // the rounds reached their cap.
+  std::vector<std::string> noise_unsettled;
   // Groups of a correction's variances the data leave at zero (their factor
   // under 0.01): learned by one step down, no further rounds.
   std::vector<std::string> scales_at_boundary;

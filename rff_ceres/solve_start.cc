@@ -113,6 +113,8 @@ std::shared_ptr<const MeanFunction> BuildMean(
     }
     result->noise_kept = wnoa.noise_kept;
     result->noise_learned = wnoa.noise_learned;
+    result->noise_unsettled = wnoa.noise_unsettled;
+    result->noise_evidence_fell = wnoa.noise_evidence_fell;
     // The solve's landmarks start the RFF solve either way: as a mean, the
     // trajectory is already where the correction starts.
     for (const Landmark& l : wnoa.landmarks) {
