@@ -822,24 +822,24 @@ TEST(VarianceComponentsTest, EvidencePeaksAtTheFixedPointWnoa) {
   ExpectEvidencePeaksAtTheFixedPoint(options);
 }
 
-TEST(VarianceComponentsTest, EvidencePeaksAtTheFixedPointRff) {
+// The RFF prior as one global feature map of 20 weights per coordinate.
+SlamOptions OneGlobalFeatureMap() {
   SlamOptions options;
   options.prior = "rff";
   options.features.num_position_features = 20;
   options.features.num_heading_features = 20;
   options.features.segment_length = 0.0;
-  ExpectEvidencePeaksAtTheFixedPoint(options);
+  return options;
+}
+
+TEST(VarianceComponentsTest, EvidencePeaksAtTheFixedPointRff) {
+  ExpectEvidencePeaksAtTheFixedPoint(OneGlobalFeatureMap());
 }
 
 // One global feature map: every row is dense over the 3 x 20 weights, so
 // A = J_t^T J_t by dense products.
 TEST(VarianceComponentsTest, RedundanciesMatchTheExactTracesRffDenseRows) {
-  SlamOptions options;
-  options.prior = "rff";
-  options.features.num_position_features = 20;
-  options.features.num_heading_features = 20;
-  options.features.segment_length = 0.0;
-  ExpectRedundanciesMatchTheExactTraces(options);
+  ExpectRedundanciesMatchTheExactTraces(OneGlobalFeatureMap());
 }
 
 }  // namespace
