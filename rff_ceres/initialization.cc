@@ -124,7 +124,17 @@ Dataset ResolveStartHeading(const Dataset& dataset, StartHeading* report) {
   }
   PosePrior* first = &EarliestPosePrior(&resolved);
   report->prior_heading = report->heading = first->pose.theta;
-  if (!(first->sigma_theta > kLooseHeadingSigma)) return resolved;
+  // Every PRIOR_POSE at the start holds its heading: it is unknown only
+  // when their information together is looser than kLooseHeadingSigma.
+  double information = 0.0;
+  for (const PosePrior& p : resolved.pose_priors) {
+    if (p.pose.t == first->pose.t) {
+      information += 1.0 / (p.sigma_theta * p.sigma_theta);
+    }
+  }
+  if (!(information < 1.0 / (kLooseHeadingSigma * kLooseHeadingSigma))) {
+    return resolved;
+  }
 
   DeadReckoningResult dr;
   DeadReckoningOptions dr_options;
@@ -182,6 +192,11 @@ Dataset ResolveStartHeading(const Dataset& dataset, StartHeading* report) {
   if (refined_cost < best_cost) {
     best = refined;
     best_cost = refined_cost;
+  }
+  for (PosePrior& p : resolved.pose_priors) {
+    if (p.pose.t == first->pose.t && &p != first) {
+      p.pose.theta = WrapAngle(p.pose.theta + best);
+    }
   }
   first->pose.theta = WrapAngle(first->pose.theta + best);
   report->resolved = true;

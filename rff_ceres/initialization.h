@@ -33,12 +33,13 @@ struct StartHeading {
   double prior_cost = 0.0;
 };
 
-// When the earliest PRIOR_POSE's heading is loose and the dataset has
-// odometry and landmark priors, scans start headings (every 2 pi / 72, then a
-// golden-section refinement) for the one whose dead reckoning best explains
-// the observations against the landmark priors (Cauchy cost of the whitened
-// residuals, landmark sigma added to the measurement noise). Returns a copy
-// of `dataset` whose earliest PRIOR_POSE carries that heading (same sigma).
+// When the PRIOR_POSEs at the earliest time hold the heading loosely
+// (together) and the dataset has odometry and landmark priors, scans start
+// headings (every 2 pi / 72, then a golden-section refinement) for the one
+// whose dead reckoning best explains the observations against the landmark
+// priors (Cauchy cost of the whitened residuals, landmark sigma added to
+// the measurement noise). Returns a copy of `dataset` whose PRIOR_POSEs at
+// that time are turned by the same angle (same sigmas).
 Dataset ResolveStartHeading(const Dataset& dataset, StartHeading* report);
 
 // The pilot: localisation against the landmark priors (fused with odometry

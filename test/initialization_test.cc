@@ -12,6 +12,7 @@
 #include "rff_ceres/feature_trajectory.h"
 #include "rff_ceres/mean/mean_function.h"
 #include "rff_ceres/se2.h"
+#include "rff_ceres/simulate.h"
 
 namespace rff {
 namespace {
@@ -92,6 +93,50 @@ TEST(FitModelToPosesTest, WindowedFitIsCeresMap) {
   for (const TimedPose& p : poses) {
     EXPECT_NEAR((fitted->Pose(p.t) - reference->Pose(p.t)).norm(), 0.0, 5e-5)
         << "t = " << p.t;
+  }
+}
+
+// A simulated run whose start carries two PRIOR_POSEs, both turned by 90
+// degrees, with heading sigmas `sigma_a` and `sigma_b`.
+Dataset TwoStartPriors(double sigma_a, double sigma_b) {
+  SimulationOptions sim = PaperOptions(31);
+  sim.landmark_prior_sigma = 1.0;
+  Dataset dataset;
+  std::string error;
+  EXPECT_TRUE(Simulate(sim, &dataset, &error)) << error;
+  PosePrior& start = EarliestPosePrior(&dataset);
+  start.pose.theta = WrapAngle(start.pose.theta + 0.5 * M_PI);
+  start.sigma_theta = sigma_a;
+  PosePrior second = start;
+  second.sigma_theta = sigma_b;
+  dataset.pose_priors.push_back(second);
+  return dataset;
+}
+
+// Every PRIOR_POSE at the start is turned to the heading found: one left
+// would hold the start at the heading the search corrected.
+TEST(ResolveStartHeadingTest, TurnsEveryPriorAtTheStart) {
+  const Dataset dataset = TwoStartPriors(M_PI, M_PI);
+  StartHeading report;
+  const Dataset resolved = ResolveStartHeading(dataset, &report);
+  ASSERT_TRUE(report.resolved);
+  const double truth = dataset.ground_truth.front().theta;
+  EXPECT_LT(std::abs(WrapAngle(report.heading - truth)), 0.1);
+  ASSERT_EQ(resolved.pose_priors.size(), dataset.pose_priors.size());
+  EXPECT_EQ(resolved.pose_priors.front().pose.theta, report.heading);
+  EXPECT_EQ(resolved.pose_priors.back().pose.theta, report.heading);
+}
+
+// A tight prior beside a loose one at the start fixes the heading: nothing
+// is searched or turned.
+TEST(ResolveStartHeadingTest, ATightPriorAtTheStartKeepsItsHeading) {
+  const Dataset dataset = TwoStartPriors(M_PI, 0.01);
+  StartHeading report;
+  const Dataset resolved = ResolveStartHeading(dataset, &report);
+  EXPECT_FALSE(report.resolved);
+  for (std::size_t k = 0; k < dataset.pose_priors.size(); ++k) {
+    EXPECT_EQ(resolved.pose_priors[k].pose.theta,
+              dataset.pose_priors[k].pose.theta);
   }
 }
 
