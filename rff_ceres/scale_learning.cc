@@ -36,6 +36,12 @@ constexpr double kEvidenceRounding = 1e-9;
 // would drive them to 0 and the system to no digits.
 constexpr double kMaxNoiseScale = 1e3;
 
+// Whether a noise factor sits at its lower bound: the product of the
+// rounds' steps lands there up to a rounding unit.
+bool AtNoiseFloor(double factor) {
+  return factor <= (1.0 + 1e-12) / kMaxNoiseScale;
+}
+
 // Whether either loss is still to be judged.
 bool HasAutoLoss(const ProblemOptions& options) {
   return options.loss.name == "auto" || options.odometry_loss.name == "auto";
@@ -143,8 +149,11 @@ bool LearnScales(const Dataset& dataset,
   // The evidence is the Gaussian rows' (LaplaceLogEvidence). Under a robust
   // loss the rounds rescale the loss-corrected residuals, whose fixed point
   // is no stationary point of it: it guards nothing there.
-  const bool gaussian = settled->problem.loss.name == "none" &&
-                        settled->problem.odometry_loss.name == "none";
+  const bool odometry_rows =
+      settled->problem.use_odometry && !dataset.odometry.empty();
+  const bool gaussian =
+      settled->problem.loss.name == "none" &&
+      (settled->problem.odometry_loss.name == "none" || !odometry_rows);
   // What the last round solved with (its scales, the groups then at their
   // boundary, its factors) and its evidence; whether the rounds climbed.
   struct Solved {
@@ -213,7 +222,7 @@ bool LearnScales(const Dataset& dataset,
       Falls& f = falls[group];
       // A sigma at its lower bound falls no further: its factors there are
       // the rounding of residuals near zero, not a trend.
-      const bool at_bound = power < 1.0 && *scale <= 1.0 / kMaxNoiseScale;
+      const bool at_bound = power < 1.0 && AtNoiseFloor(*scale);
       f.accelerating =
           !at_bound && fall > 0.0 && fall >= f.last ? f.accelerating + 1 : 0;
       f.last = fall;
@@ -337,10 +346,10 @@ bool LearnScales(const Dataset& dataset,
   for (const VarianceGroup group : learned) {
     if (kept.count(group) > 0) continue;
     result->noise_learned.push_back(VarianceGroupName(group));
-    // Still falling at the cap while the evidence climbs: the sigma, and
-    // the covariances that follow it, sit where the cap stopped them.
+    // Still falling at the cap, above its bound: the sigma, and the
+    // covariances that follow it, sit where the cap stopped them.
     if (capped && falls[group].last > std::log1p(kScaleTolerance) &&
-        NoiseScale(sigmas, group) > 1.0 / kMaxNoiseScale) {
+        !AtNoiseFloor(NoiseScale(sigmas, group))) {
       result->noise_unsettled.push_back(VarianceGroupName(group));
     }
   }

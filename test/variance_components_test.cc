@@ -315,6 +315,25 @@ TEST(VarianceComponentsTest, RobustLossesLeaveTheRoundsToTheirFactors) {
   EXPECT_GT(result.noise.bearing, 4.0);
 }
 
+// Noise-free data run every sigma down to its bound, where the product of
+// the rounds' steps may land a rounding unit above it: a sigma there has
+// stopped falling and is not named as unsettled. Seed 5's odometry landed
+// at 0.0010000000000000002.
+TEST(VarianceComponentsTest, ASigmaAtItsBoundIsNotUnsettled) {
+  SimulationOptions sim = PaperOptions(5);
+  sim.noise_free = true;
+  Dataset dataset;
+  std::string error;
+  ASSERT_TRUE(Simulate(sim, &dataset, &error)) << error;
+  SlamOptions options;
+  options.prior = "wnoa";
+  SlamResult result;
+  ASSERT_TRUE(RunSlam(dataset, options, &result, &error)) << error;
+  EXPECT_NEAR(result.noise.odometry, 1e-3, 1e-15);
+  EXPECT_EQ(result.learning_rounds, 12);
+  EXPECT_TRUE(result.noise_unsettled.empty());
+}
+
 // A sigma still falling when the rounds reach their cap is named with the
 // covariances (and in the JSON whatever was asked for).
 TEST(VarianceComponentsTest, UnsettledSigmaIsNamedWithTheCovariances) {
