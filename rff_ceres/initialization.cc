@@ -194,11 +194,10 @@ Dataset ResolveStartHeading(const Dataset& dataset, StartHeading* report) {
     best_cost = refined_cost;
   }
   for (PosePrior& p : resolved.pose_priors) {
-    if (p.pose.t == first->pose.t && &p != first) {
+    if (p.pose.t == first->pose.t) {
       p.pose.theta = WrapAngle(p.pose.theta + best);
     }
   }
-  first->pose.theta = WrapAngle(first->pose.theta + best);
   report->resolved = true;
   report->heading = first->pose.theta;
   report->cost = best_cost;
