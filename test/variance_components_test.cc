@@ -173,6 +173,29 @@ void ModelAboutAConstantMean(const Dataset& dataset, const SlamOptions& options,
   ASSERT_NE(*model, nullptr) << error;
 }
 
+// `sim` simulated; a failure is recorded where it cannot be.
+Dataset Simulated(const SimulationOptions& sim) {
+  Dataset dataset;
+  std::string error;
+  EXPECT_TRUE(Simulate(sim, &dataset, &error)) << error;
+  return dataset;
+}
+
+// Default flags but the WNOA prior, whose learning rounds these tests watch.
+SlamOptions WnoaDefaults() {
+  SlamOptions options;
+  options.prior = "wnoa";
+  return options;
+}
+
+// The solve of `dataset` under `options`; a failure is recorded.
+SlamResult Solved(const Dataset& dataset, const SlamOptions& options) {
+  SlamResult result;
+  std::string error;
+  EXPECT_TRUE(RunSlam(dataset, options, &result, &error)) << error;
+  return result;
+}
+
 // A short WNOA draw with its WNOA model about a constant mean.
 struct WnoaDrawModel {
   WnoaDrawModel() {
@@ -252,13 +275,9 @@ TEST(VarianceComponentsTest,
     SimulationOptions sim = PaperOptions(seed);
     sim.num_steps = 60;
     sim.num_landmarks = 10;
-    Dataset dataset;
-    std::string error;
-    ASSERT_TRUE(Simulate(sim, &dataset, &error)) << error;
-    SlamOptions options;
-    options.prior = "wnoa";
-    SlamResult result;
-    ASSERT_TRUE(RunSlam(dataset, options, &result, &error)) << error;
+    const Dataset dataset = Simulated(sim);
+    SlamOptions options = WnoaDefaults();
+    const SlamResult result = Solved(dataset, options);
     std::printf("seed %llu: odometry %.3f after %d rounds\n",
                 static_cast<unsigned long long>(seed), result.noise.odometry,
                 result.learning_rounds);
@@ -281,9 +300,7 @@ TEST(VarianceComponentsTest,
         << summary.str();
     // The RFF prior solves with (and reports) the scales of its WNOA mean.
     options.prior = "rff";
-    SlamResult rff;
-    ASSERT_TRUE(RunSlam(dataset, options, &rff, &error)) << error;
-    EXPECT_EQ(rff.noise.odometry, result.noise.odometry);
+    EXPECT_EQ(Solved(dataset, options).noise.odometry, result.noise.odometry);
   }
 }
 
@@ -293,18 +310,12 @@ TEST(VarianceComponentsTest,
 // the sigmas rise towards the drawn ones as before the guard. Measured:
 // range 5.2, bearing 5.6 after 9 rounds.
 TEST(VarianceComponentsTest, RobustLossesLeaveTheRoundsToTheirFactors) {
-  SimulationOptions sim = PaperOptions(42);
-  Dataset dataset;
-  std::string error;
-  ASSERT_TRUE(Simulate(sim, &dataset, &error)) << error;
+  Dataset dataset = Simulated(PaperOptions(42));
   for (Observation& o : dataset.observations) {
     o.sigma_range *= 0.1;
     o.sigma_bearing *= 0.1;
   }
-  SlamOptions options;
-  options.prior = "wnoa";
-  SlamResult result;
-  ASSERT_TRUE(RunSlam(dataset, options, &result, &error)) << error;
+  const SlamResult result = Solved(dataset, WnoaDefaults());
   std::printf("range %.3f bearing %.3f after %d rounds, loss %s\n",
               result.noise.range, result.noise.bearing, result.learning_rounds,
               result.loss.c_str());
@@ -322,13 +333,7 @@ TEST(VarianceComponentsTest, RobustLossesLeaveTheRoundsToTheirFactors) {
 TEST(VarianceComponentsTest, ASigmaAtItsBoundIsNotUnsettled) {
   SimulationOptions sim = PaperOptions(5);
   sim.noise_free = true;
-  Dataset dataset;
-  std::string error;
-  ASSERT_TRUE(Simulate(sim, &dataset, &error)) << error;
-  SlamOptions options;
-  options.prior = "wnoa";
-  SlamResult result;
-  ASSERT_TRUE(RunSlam(dataset, options, &result, &error)) << error;
+  const SlamResult result = Solved(Simulated(sim), WnoaDefaults());
   EXPECT_NEAR(result.noise.odometry, 1e-3, 1e-15);
   EXPECT_EQ(result.learning_rounds, 12);
   EXPECT_TRUE(result.noise_unsettled.empty());
@@ -366,16 +371,11 @@ TEST(VarianceComponentsTest, OdometrySigmaRunningToZeroKeepsTheStatedOne) {
   SimulationOptions sim = PaperOptions(1);
   sim.num_steps = 60;
   sim.num_landmarks = 10;
-  Dataset dataset, exact;
-  std::string error;
-  ASSERT_TRUE(Simulate(sim, &dataset, &error)) << error;
+  Dataset dataset = Simulated(sim);
   sim.noise_free = true;
-  ASSERT_TRUE(Simulate(sim, &exact, &error)) << error;
-  dataset.odometry = exact.odometry;
-  SlamOptions options;
-  options.prior = "wnoa";
-  SlamResult result;
-  ASSERT_TRUE(RunSlam(dataset, options, &result, &error)) << error;
+  dataset.odometry = Simulated(sim).odometry;
+  const SlamOptions options = WnoaDefaults();
+  const SlamResult result = Solved(dataset, options);
   EXPECT_EQ(result.noise_kept, std::vector<std::string>{"odometry"});
   EXPECT_EQ(result.noise.odometry, 1.0);
   // A kept sigma is not reported as learned, nor printed as a factor.
@@ -450,13 +450,7 @@ TEST(VarianceComponentsTest, NoiseFreeDataStopAtTheSigmaBound) {
   sim.num_steps = 60;
   sim.num_landmarks = 10;
   sim.noise_free = true;
-  Dataset dataset;
-  std::string error;
-  ASSERT_TRUE(Simulate(sim, &dataset, &error)) << error;
-  SlamOptions options;
-  options.prior = "wnoa";
-  SlamResult result;
-  ASSERT_TRUE(RunSlam(dataset, options, &result, &error)) << error;
+  const SlamResult result = Solved(Simulated(sim), WnoaDefaults());
   EXPECT_DOUBLE_EQ(result.noise.range, 1e-3);
   EXPECT_DOUBLE_EQ(result.noise.bearing, 1e-3);
   EXPECT_FALSE(result.learning_converged);
