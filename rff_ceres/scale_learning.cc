@@ -107,6 +107,18 @@ bool SettleAutoLosses(SlamProblem* problem, ProblemOptions* options) {
   return judged;
 }
 
+bool DataMeasureDistance(const Dataset& dataset,
+                         const ProblemOptions& options) {
+  if (options.use_odometry && !dataset.odometry.empty()) return true;
+  for (const Observation& o : dataset.observations) {
+    if (o.HasRange()) return true;
+  }
+  for (const PosePrior& p : dataset.pose_priors) {
+    if (p.pose.t != dataset.pose_priors.front().pose.t) return true;
+  }
+  return false;
+}
+
 bool LearnScales(const Dataset& dataset,
                  std::shared_ptr<const MeanFunction> mean,
                  const ceres::Solver::Options& ceres_options,
@@ -116,6 +128,16 @@ bool LearnScales(const Dataset& dataset,
                  std::unique_ptr<SlamProblem>* problem, SlamResult* result,
                  std::string* error) {
   const TrajectoryPrior& prior = PriorOf(*settled);
+  // Bearings alone: a smaller Q_c shrinks the trajectory, whose smaller
+  // accelerations then ask for a smaller Q_c still (the map 20-35% small on
+  // the paper's bearing-only runs with 10 landmarks; docs/uncertainty.md).
+  const bool prior_scales_learned =
+      DataMeasureDistance(dataset, settled->problem);
+  if (!prior_scales_learned) {
+    result->prior_scales_kept =
+        "nothing in the data measures distance (no range, no odometry, "
+        "positions given at one time)";
+  }
   double* position_scale = prior.PositionScale(settled);
   double* heading_scale = prior.HeadingScale(settled);
   NoiseScales& sigmas = settled->problem.noise;
@@ -204,7 +226,8 @@ bool LearnScales(const Dataset& dataset,
     // `power` 1 for a variance, 0.5 for a sigma.
     auto rescale = [&](VarianceGroup group, double power, double* scale) {
       const VarianceComponent& c = components[static_cast<int>(group)];
-      if (!c.estimated || kept.count(group) > 0 || at_boundary.count(group)) {
+      if (!c.estimated || kept.count(group) > 0 || at_boundary.count(group) ||
+          (power == 1.0 && !prior_scales_learned)) {
         return;
       }
       if (power == 1.0 && prior.has_features() &&

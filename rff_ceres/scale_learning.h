@@ -38,6 +38,13 @@ std::array<double, kNumVarianceGroups> LogRowScales(
     const TrajectoryModel& model, double position_scale, double heading_scale,
     const NoiseScales& noise);
 
+// Whether the data measure distance: a range, odometry the problem uses, or
+// positions given at two or more times. Bearings and landmark priors alone
+// leave the trajectory's size to the motion prior, whose scales the
+// variance components would then read off a trajectory the prior itself
+// sized (LearnScales holds them).
+bool DataMeasureDistance(const Dataset& dataset, const ProblemOptions& options);
+
 // Learns the scales of the trajectory prior (WNOA Q_c, RFF kernel
 // variances) of x, y and theta and, where `noise`, the factors on the sigmas
 // of range, bearing and odometry: after the first MAP, each round rescales
@@ -48,7 +55,9 @@ std::array<double, kNumVarianceGroups> LogRowScales(
 // several times tighter than stated (docs/heldout.md). `loose`: the problem
 // was solved at kPlacingTolerance only. A correction to the mean whose
 // factor is under 0.01 (its variance at zero, as far as the data tell)
-// takes one tenfold step down and is learned no further.
+// takes one tenfold step down and is learned no further. Where the data
+// measure no distance (DataMeasureDistance) the prior's scales stay as
+// given and only the noise factors are learned.
 bool LearnScales(const Dataset& dataset,
                  std::shared_ptr<const MeanFunction> mean,
                  const ceres::Solver::Options& ceres_options,

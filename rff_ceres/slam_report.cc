@@ -70,8 +70,12 @@ void PrintSlamSummary(const SlamOptions& options, const SlamResult& result,
   const TrajectoryPrior& prior = PriorOf(options);
   prior.PrintModel(result, out);
   if (result.learning_rounds > 0) {
-    *out << "  scales       " << prior.scales_name()
-         << " learned by variance components, " << result.learning_rounds
+    *out << "  scales       " << prior.scales_name();
+    if (!result.prior_scales_kept.empty()) {
+      *out << " kept as given: " << result.prior_scales_kept
+           << "; the noise factors";
+    }
+    *out << " learned by variance components, " << result.learning_rounds
          << (result.learning_rounds == 1 ? " round" : " rounds")
          << (result.learning_converged ? ""
              : result.learning_evidence_fell
@@ -259,6 +263,8 @@ void WriteSummaryJson(const SlamOptions& options, const SlamResult& result,
       << "  \"noise_unsettled\": " << JsonStringArray(result.noise_unsettled)
       << ",\n"
       << "  \"scales_not_learned\": " << JsonString(result.scales_not_learned)
+      << ",\n"
+      << "  \"prior_scales_kept\": " << JsonString(result.prior_scales_kept)
       << ",\n"
       << "  \"prior_scale_factors\": ["
       << FormatNumber(result.prior_scale_factors[0]) << ", "

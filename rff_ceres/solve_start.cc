@@ -121,6 +121,8 @@ std::shared_ptr<const MeanFunction> BuildMean(
       warm->start.landmarks[l.id] = Eigen::Vector2d(l.x, l.y);
     }
     if (wnoa_mean) {
+      // Its Q_c is the mean's; a start only leaves the prior its own.
+      result->prior_scales_kept = wnoa.prior_scales_kept;
       mean = std::make_shared<PiecewiseLinearMean>(wnoa.trajectory);
       *wnoa_mean_solve = std::move(wnoa);
     } else {
