@@ -130,7 +130,7 @@ bool LearnScales(const Dataset& dataset,
   const TrajectoryPrior& prior = PriorOf(*settled);
   // Bearings alone: a smaller Q_c shrinks the trajectory, whose smaller
   // accelerations then ask for a smaller Q_c still (the map 20-35% small on
-  // the paper's bearing-only runs with 10 landmarks; docs/uncertainty.md).
+  // the paper's bearing-only runs with 10 landmarks; docs/heldout.md).
   const bool prior_scales_learned =
       DataMeasureDistance(dataset, settled->problem);
   if (!prior_scales_learned) {

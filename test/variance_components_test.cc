@@ -454,6 +454,11 @@ TEST(VarianceComponentsTest, BearingsAloneKeepTheGivenQcAndLearnTheirSigma) {
                                  "measures distance"),
               std::string::npos)
         << summary.str();
+    std::ostringstream json;
+    WriteSummaryJson(options, result, &json);
+    EXPECT_NE(json.str().find("\"prior_scales_kept\": \"nothing in the data "
+                              "measures distance"),
+              std::string::npos);
   }
 }
 
