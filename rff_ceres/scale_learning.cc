@@ -4,8 +4,10 @@
 #include <array>
 #include <cmath>
 #include <initializer_list>
+#include <iomanip>
 #include <limits>
 #include <set>
+#include <sstream>
 #include <vector>
 
 #include "glog/logging.h"
@@ -107,16 +109,45 @@ bool SettleAutoLosses(SlamProblem* problem, ProblemOptions* options) {
   return judged;
 }
 
-bool DataMeasureDistance(const Dataset& dataset,
-                         const ProblemOptions& options) {
-  if (options.use_odometry && !dataset.odometry.empty()) return true;
+double ScaleInformation(const Dataset& dataset, const ProblemOptions& options) {
+  Eigen::Vector2d start = Eigen::Vector2d::Zero();
+  if (!dataset.pose_priors.empty()) {
+    const PosePrior& first = *std::min_element(
+        dataset.pose_priors.begin(), dataset.pose_priors.end(),
+        [](const PosePrior& a, const PosePrior& b) {
+          return a.pose.t < b.pose.t;
+        });
+    start = Eigen::Vector2d(first.pose.x, first.pose.y);
+  } else {
+    double weights = 0.0;
+    for (const LandmarkPrior& l : dataset.landmark_priors) {
+      const double w = 1.0 / (l.sigma * l.sigma);
+      start += w * Eigen::Vector2d(l.x, l.y);
+      weights += w;
+    }
+    if (weights > 0.0) start /= weights;
+  }
+  double information = 0.0;
   for (const Observation& o : dataset.observations) {
-    if (o.HasRange()) return true;
+    if (o.HasRange()) {
+      information += o.range * o.range / (o.sigma_range * o.sigma_range);
+    }
+  }
+  if (options.use_odometry) {
+    for (const Odometry& o : dataset.odometry) {
+      information += o.dx * o.dx / (o.sigma_x * o.sigma_x) +
+                     o.dy * o.dy / (o.sigma_y * o.sigma_y);
+    }
+  }
+  for (const LandmarkPrior& l : dataset.landmark_priors) {
+    information +=
+        (Eigen::Vector2d(l.x, l.y) - start).squaredNorm() / (l.sigma * l.sigma);
   }
   for (const PosePrior& p : dataset.pose_priors) {
-    if (p.pose.t != dataset.pose_priors.front().pose.t) return true;
+    information += (Eigen::Vector2d(p.pose.x, p.pose.y) - start).squaredNorm() /
+                   (p.sigma_xy * p.sigma_xy);
   }
-  return false;
+  return information;
 }
 
 bool LearnScales(const Dataset& dataset,
@@ -128,17 +159,12 @@ bool LearnScales(const Dataset& dataset,
                  std::unique_ptr<SlamProblem>* problem, SlamResult* result,
                  std::string* error) {
   const TrajectoryPrior& prior = PriorOf(*settled);
-  // Bearings alone: a smaller Q_c shrinks the trajectory, whose smaller
-  // accelerations then ask for a smaller Q_c still (maps 0.64-0.89 of their
-  // size on the paper's bearing-only runs with 10 landmarks;
-  // docs/heldout.md).
-  const bool prior_scales_learned =
-      DataMeasureDistance(dataset, settled->problem);
-  if (!prior_scales_learned) {
-    result->prior_scales_kept =
-        "nothing in the data measures distance (no range, no odometry, "
-        "positions given at one time)";
-  }
+  // Whether the data hold the trajectory's size against the prior's pull
+  // (below), and the scales as given, which it keeps where they do not.
+  bool prior_scales_learned = true;
+  const double scale_information = ScaleInformation(dataset, settled->problem);
+  const double given_position = *prior.PositionScale(settled);
+  const double given_heading = *prior.HeadingScale(settled);
   double* position_scale = prior.PositionScale(settled);
   double* heading_scale = prior.HeadingScale(settled);
   NoiseScales& sigmas = settled->problem.noise;
@@ -198,6 +224,30 @@ bool LearnScales(const Dataset& dataset,
       result->scales_not_learned = why;
       break;
     }
+    // Scaling the positions about the start by 1 + s scales the position
+    // prior's whitened rows; at Q_c's fixed point their squares sum to the
+    // group's redundancy R, the prior's pull on s^2. With the data's I the
+    // MAP's size s then solves I (1 - s) = R / s (the accelerations and Q_c
+    // follow s^2), which has a root near 1 only where 4 R < I: beyond, a
+    // learned Q_c feeds on itself (a smaller trajectory, smaller
+    // accelerations, a smaller Q_c; bearing-only maps at 0.64-0.89 of their
+    // size, docs/heldout.md). Q_c then goes back to the given value.
+    const double redundancy =
+        components[static_cast<int>(VarianceGroup::kPriorPosition)].redundancy;
+    const bool prior_scales_reset =
+        prior_scales_learned && 4.0 * redundancy > scale_information;
+    if (prior_scales_reset) {
+      prior_scales_learned = false;
+      *position_scale = given_position;
+      *heading_scale = given_heading;
+      std::ostringstream why;
+      why << std::setprecision(3)
+          << "the data hold the trajectory's size too loosely for a learned "
+             "one (the prior's pull "
+          << redundancy << " against the data's scale information "
+          << scale_information << ", under 4 times the pull)";
+      result->prior_scales_kept = why.str();
+    }
     const Eigen::Vector2d prior_factors(
         components[static_cast<int>(VarianceGroup::kPriorPosition)].factor,
         components[static_cast<int>(VarianceGroup::kPriorHeading)].factor);
@@ -220,7 +270,9 @@ bool LearnScales(const Dataset& dataset,
         gaussian && climbed &&
         solved.log_evidence < last.log_evidence - rounding;
     climbed = climbed || (round > 0 && solved.log_evidence > last.log_evidence);
-    double largest_step = 0.0;
+    double largest_step = prior_scales_reset && round > 0
+                              ? std::numeric_limits<double>::infinity()
+                              : 0.0;
     const std::size_t boundary_before = at_boundary.size();
     const double position_solved = *position_scale;
     const double heading_solved = *heading_scale;

@@ -38,12 +38,15 @@ std::array<double, kNumVarianceGroups> LogRowScales(
     const TrajectoryModel& model, double position_scale, double heading_scale,
     const NoiseScales& noise);
 
-// Whether the data measure distance: a range, odometry the problem uses, or
-// positions given at two or more times. Bearings and landmark priors alone
-// leave the trajectory's size to the motion prior, whose scales the
-// variance components would then read off a trajectory the prior itself
-// sized (LearnScales holds them).
-bool DataMeasureDistance(const Dataset& dataset, const ProblemOptions& options);
+// The information the data carry on the size of the scene about the start
+// (the earliest pose prior, else the map priors' weighted centroid), per
+// unit of s^2 where every position moves to start + (1 + s)(p - start): a
+// range r moves by s r, an odometry step d by s d, a map or pose prior at
+// offset o from the start by s o, a bearing not at all. So
+//   I = sum r^2 / sigma_r^2 + sum (dx^2 / sigma_x^2 + dy^2 / sigma_y^2)
+//       + sum |o|^2 / sigma^2
+// over ranges, the odometry the problem uses, and map and pose priors.
+double ScaleInformation(const Dataset& dataset, const ProblemOptions& options);
 
 // Learns the scales of the trajectory prior (WNOA Q_c, RFF kernel
 // variances) of x, y and theta and, where `noise`, the factors on the sigmas
@@ -56,8 +59,9 @@ bool DataMeasureDistance(const Dataset& dataset, const ProblemOptions& options);
 // was solved at kPlacingTolerance only. A correction to the mean whose
 // factor is under 0.01 (its variance at zero, as far as the data tell)
 // takes one tenfold step down and is learned no further. Where the data
-// measure no distance (DataMeasureDistance) the prior's scales stay as
-// given and only the noise factors are learned.
+// hold the trajectory's size too loosely (ScaleInformation against the
+// prior's pull at the first MAP) the prior's scales stay as given and only
+// the noise factors are learned.
 bool LearnScales(const Dataset& dataset,
                  std::shared_ptr<const MeanFunction> mean,
                  const ceres::Solver::Options& ceres_options,
