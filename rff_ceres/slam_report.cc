@@ -71,11 +71,16 @@ void PrintSlamSummary(const SlamOptions& options, const SlamResult& result,
   prior.PrintModel(result, out);
   if (result.learning_rounds > 0) {
     *out << "  scales       " << prior.scales_name();
-    if (!result.prior_scales_kept.empty()) {
+    if (result.prior_scales_kept.empty()) {
+      *out << " learned by variance components, ";
+    } else {
+      // A feature prior's rounds learn no noise: its mean's solve did.
       *out << " kept as given: " << result.prior_scales_kept
-           << "; the noise factors";
+           << (prior.has_features()
+                   ? ", "
+                   : "; the noise factors learned by variance components, ");
     }
-    *out << " learned by variance components, " << result.learning_rounds
+    *out << result.learning_rounds
          << (result.learning_rounds == 1 ? " round" : " rounds")
          << (result.learning_converged ? ""
              : result.learning_evidence_fell

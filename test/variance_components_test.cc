@@ -470,6 +470,16 @@ TEST(VarianceComponentsTest, BearingsAloneKeepTheGivenQcWhereTheSizeIsLoose) {
   EXPECT_NE(json.str().find("\"prior_scales_kept\": \"the data hold"),
             std::string::npos);
 
+  // An RFF prior's rounds about such a mean learn no noise factors.
+  SlamOptions rff = options;
+  rff.prior = "rff";
+  std::ostringstream rff_summary;
+  PrintSlamSummary(rff, result, &rff_summary);
+  EXPECT_NE(rff_summary.str().find("too loosely for a learned one ("),
+            std::string::npos);
+  EXPECT_EQ(rff_summary.str().find("noise factors"), std::string::npos)
+      << rff_summary.str();
+
   sim.landmark_prior_sigma = 0.1;
   const SlamResult mapped = Solved(Simulated(sim), options);
   EXPECT_TRUE(mapped.prior_scales_kept.empty()) << mapped.prior_scales_kept;
