@@ -71,8 +71,8 @@ DEFINE_string(learn_hyperparameters, "auto",
               "about a WNOA solve (auto: without odometry), and the variances "
               "of the correction to a wnoa mean; WNOA: Q_c and the factors "
               "on the data's stated sigmas (range, bearing, odometry) by "
-              "variance components (Q_c kept where nothing measures "
-              "distance), the RFF prior solving with those of its "
+              "variance components (Q_c kept where the data leave the "
+              "size loose), the RFF prior solving with those of its "
               "WNOA mean. Batch mode only. auto is off when a kernel "
               "hyperparameter or Q_c is given (command line or flagfile): "
               "they are then the user's choice.");

@@ -238,8 +238,6 @@ bool LearnScales(const Dataset& dataset,
         prior_scales_learned && 4.0 * redundancy > scale_information;
     if (prior_scales_reset) {
       prior_scales_learned = false;
-      *position_scale = given_position;
-      *heading_scale = given_heading;
       std::ostringstream why;
       why << std::setprecision(3)
           << "the data hold the trajectory's size too loosely for a learned "
@@ -267,12 +265,21 @@ bool LearnScales(const Dataset& dataset,
     const double rounding =
         kEvidenceRounding * std::max(1.0, std::abs(last.log_evidence));
     const bool evidence_fell =
-        gaussian && climbed &&
+        gaussian && climbed && !prior_scales_reset &&
         solved.log_evidence < last.log_evidence - rounding;
     climbed = climbed || (round > 0 && solved.log_evidence > last.log_evidence);
-    double largest_step = prior_scales_reset && round > 0
-                              ? std::numeric_limits<double>::infinity()
-                              : 0.0;
+    double largest_step = 0.0;
+    if (prior_scales_reset) {
+      // Back to the given scales: a jump, not a step of the climb, and a
+      // model to rescale and solve again where they had moved.
+      if (*position_scale != given_position ||
+          *heading_scale != given_heading) {
+        largest_step = std::numeric_limits<double>::infinity();
+      }
+      *position_scale = given_position;
+      *heading_scale = given_heading;
+      climbed = false;
+    }
     const std::size_t boundary_before = at_boundary.size();
     const double position_solved = *position_scale;
     const double heading_solved = *heading_scale;

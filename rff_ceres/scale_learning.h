@@ -58,9 +58,9 @@ double ScaleInformation(const Dataset& dataset, const ProblemOptions& options);
 // several times tighter than stated (docs/heldout.md). `loose`: the problem
 // was solved at kPlacingTolerance only. A correction to the mean whose
 // factor is under 0.01 (its variance at zero, as far as the data tell)
-// takes one tenfold step down and is learned no further. Where the data
-// hold the trajectory's size too loosely (ScaleInformation against the
-// prior's pull at the first MAP) the prior's scales stay as given and only
+// takes one tenfold step down and is learned no further. From the round
+// the data hold the trajectory's size too loosely (ScaleInformation against
+// the prior's pull) the prior's scales go back to the given ones and only
 // the noise factors are learned.
 bool LearnScales(const Dataset& dataset,
                  std::shared_ptr<const MeanFunction> mean,

@@ -85,8 +85,9 @@ struct SlamResult {
   // Why the scales kept their values although learning was on (the
   // information matrix numerically singular); empty otherwise.
   std::string scales_not_learned;
-  // Why the prior's scales kept their values while the noise factors were
-  // learned (DataMeasureDistance false); empty otherwise.
+  // Why the prior's scales kept their given values while the noise factors
+  // were learned (the data hold the trajectory's size too loosely,
+  // LearnScales); empty otherwise.
   std::string prior_scales_kept;
   Eigen::Vector2d prior_scale_factors = Eigen::Vector2d::Ones();
   // The factors on the data's sigmas the solve ended with: learned with the
