@@ -112,12 +112,8 @@ bool SettleAutoLosses(SlamProblem* problem, ProblemOptions* options) {
 double ScaleInformation(const Dataset& dataset, const ProblemOptions& options) {
   Eigen::Vector2d start = Eigen::Vector2d::Zero();
   if (!dataset.pose_priors.empty()) {
-    const PosePrior& first = *std::min_element(
-        dataset.pose_priors.begin(), dataset.pose_priors.end(),
-        [](const PosePrior& a, const PosePrior& b) {
-          return a.pose.t < b.pose.t;
-        });
-    start = Eigen::Vector2d(first.pose.x, first.pose.y);
+    const TimedPose& first = EarliestPosePrior(dataset).pose;
+    start = Eigen::Vector2d(first.x, first.y);
   } else {
     double weights = 0.0;
     for (const LandmarkPrior& l : dataset.landmark_priors) {
@@ -163,10 +159,10 @@ bool LearnScales(const Dataset& dataset,
   // (below), and the scales as given, which it keeps where they do not.
   bool prior_scales_learned = true;
   const double scale_information = ScaleInformation(dataset, settled->problem);
-  const double given_position = *prior.PositionScale(settled);
-  const double given_heading = *prior.HeadingScale(settled);
   double* position_scale = prior.PositionScale(settled);
   double* heading_scale = prior.HeadingScale(settled);
+  const double given_position = *position_scale;
+  const double given_heading = *heading_scale;
   NoiseScales& sigmas = settled->problem.noise;
   // Per noise group: its last fall (-log factor) and the rounds in a row
   // it fell by at least the round before's.
