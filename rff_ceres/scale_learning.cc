@@ -123,18 +123,32 @@ double ScaleInformation(const Dataset& dataset, const ProblemOptions& options) {
     }
     if (weights > 0.0) start /= weights;
   }
-  double information = 0.0;
+  double ranges = 0.0;
   for (const Observation& o : dataset.observations) {
     if (o.HasRange()) {
-      information += o.range * o.range / (o.sigma_range * o.sigma_range);
+      ranges += o.range * o.range / (o.sigma_range * o.sigma_range);
     }
   }
+  double odometry = 0.0;
   if (options.use_odometry) {
     for (const Odometry& o : dataset.odometry) {
-      information += o.dx * o.dx / (o.sigma_x * o.sigma_x) +
-                     o.dy * o.dy / (o.sigma_y * o.sigma_y);
+      odometry += o.dx * o.dx / (o.sigma_x * o.sigma_x) +
+                  o.dy * o.dy / (o.sigma_y * o.sigma_y);
     }
   }
+  // A sensor whose scale is estimated passes a scaling of the scene to that
+  // scale, held only by its prior: the two informations in series.
+  const auto through_scale = [](double information, double scale_sigma) {
+    return information / (1.0 + information * scale_sigma * scale_sigma);
+  };
+  if (options.range_calibration.estimate) {
+    ranges = through_scale(ranges, options.range_calibration.scale_sigma);
+  }
+  if (options.odometry_calibration.estimate) {
+    odometry =
+        through_scale(odometry, options.odometry_calibration.scale_sigma);
+  }
+  double information = ranges + odometry;
   for (const LandmarkPrior& l : dataset.landmark_priors) {
     information +=
         (Eigen::Vector2d(l.x, l.y) - start).squaredNorm() / (l.sigma * l.sigma);
@@ -144,6 +158,11 @@ double ScaleInformation(const Dataset& dataset, const ProblemOptions& options) {
                    (p.sigma_xy * p.sigma_xy);
   }
   return information;
+}
+
+double LearnedSizeShrink(double redundancy, double information) {
+  if (!(4.0 * redundancy < information)) return 1.0;
+  return (1.0 - std::sqrt(1.0 - 4.0 * redundancy / information)) / 2.0;
 }
 
 bool LearnScales(const Dataset& dataset,
@@ -220,26 +239,34 @@ bool LearnScales(const Dataset& dataset,
       result->scales_not_learned = why;
       break;
     }
-    // Scaling the positions about the start by 1 + s scales the position
-    // prior's whitened rows; at Q_c's fixed point their squares sum to the
-    // group's redundancy R, the prior's pull on s^2. With the data's I the
-    // MAP's size s then solves I (1 - s) = R / s (the accelerations and Q_c
-    // follow s^2), which has a root near 1 only where 4 R < I: beyond, a
-    // learned Q_c feeds on itself (a smaller trajectory, smaller
-    // accelerations, a smaller Q_c; bearing-only maps at 0.64-0.89 of their
-    // size, docs/heldout.md). Q_c then goes back to the given value.
+    // A learned Q_c shrinks the scene (LearnedSizeShrink); where by more
+    // than kSizeSigmas standard deviations of the size the data fix,
+    // 1 / sqrt(I), the data would reject that size: Q_c goes back to the
+    // given value (bearing-only maps ended at 0.64-0.89 of their size, with
+    // an estimated odometry scale at 0.5-0.9; docs/heldout.md).
     const double redundancy =
         components[static_cast<int>(VarianceGroup::kPriorPosition)].redundancy;
+    const double shrink = LearnedSizeShrink(redundancy, scale_information);
+    const double size_sigma = 1.0 / std::sqrt(scale_information);
     const bool prior_scales_reset =
-        prior_scales_learned && 4.0 * redundancy > scale_information;
+        prior_scales_learned &&
+        (shrink >= 1.0 || shrink > kSizeSigmas * size_sigma);
     if (prior_scales_reset) {
       prior_scales_learned = false;
       std::ostringstream why;
       why << std::setprecision(3)
           << "the data hold the trajectory's size too loosely for a learned "
-             "one (the prior's pull "
-          << redundancy << " against the data's scale information "
-          << scale_information << ", under 4 times the pull)";
+             "one (";
+      if (shrink >= 1.0) {
+        why << "it would shrink the scene without bound";
+      } else {
+        why << "it would shrink the scene by " << 100.0 * shrink
+            << "%, more than " << kSizeSigmas << " times the size's "
+            << 100.0 * size_sigma << "% standard deviation";
+      }
+      why << ": the prior's pull " << redundancy
+          << " against the data's scale information " << scale_information
+          << ")";
       result->prior_scales_kept = why.str();
     }
     const Eigen::Vector2d prior_factors(

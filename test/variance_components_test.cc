@@ -421,11 +421,31 @@ TEST(ScaleInformationTest, SumsWhatScalingTheSceneMoves) {
                    36.0 + 6.25 + 36.0 + 100.0 + 4.0);
   options.use_odometry = false;
   EXPECT_DOUBLE_EQ(ScaleInformation(dataset, options), 36.0 + 6.25 + 36.0);
+  // An estimated scale takes a sensor's information but for its prior:
+  // ranges 36 / (1 + 36 * 0.01), odometry 104 / (1 + 104 * 0.25).
+  options.use_odometry = true;
+  options.range_calibration.estimate = true;
+  options.range_calibration.scale_sigma = 0.1;
+  options.odometry_calibration.estimate = true;
+  options.odometry_calibration.scale_sigma = 0.5;
+  EXPECT_DOUBLE_EQ(ScaleInformation(dataset, options),
+                   36.0 + 6.25 + 36.0 / 1.36 + 104.0 / 27.0);
+  options = ProblemOptions();
+  options.use_odometry = false;
   // Without pose priors the start is the map priors' weighted centroid.
   dataset.pose_priors.clear();
   dataset.landmark_priors.push_back(LandmarkPrior{8, 0.0, 2.0, 1.0});
   // Centroid (0.8, 2.6): offsets (3.2, 2.4) and (-0.8, -0.6).
   EXPECT_DOUBLE_EQ(ScaleInformation(dataset, options), 36.0 + 16.0 / 4.0 + 1.0);
+}
+
+// The root near 1 of I (1 - s) = R / s, as 1 - s; 1 without a root.
+TEST(ScaleInformationTest, LearnedSizeShrinkIsTheQuadraticsRoot) {
+  // 4 R / I = 0.5: s = (1 + sqrt(0.5)) / 2.
+  EXPECT_DOUBLE_EQ(LearnedSizeShrink(1.0, 8.0), (1.0 - std::sqrt(0.5)) / 2.0);
+  EXPECT_NEAR(LearnedSizeShrink(1.0, 1e6), 1e-6, 1e-11);
+  EXPECT_EQ(LearnedSizeShrink(1.0, 4.0), 1.0);
+  EXPECT_EQ(LearnedSizeShrink(1.0, 0.0), 1.0);
 }
 
 // The size of the map about the start pose (at the origin) against the
@@ -484,6 +504,30 @@ TEST(VarianceComponentsTest, BearingsAloneKeepTheGivenQcWhereTheSizeIsLoose) {
   const SlamResult mapped = Solved(Simulated(sim), options);
   EXPECT_TRUE(mapped.prior_scales_kept.empty()) << mapped.prior_scales_kept;
   EXPECT_LT(mapped.wnoa_options.position_qc, 0.5 * options.wnoa.position_qc);
+}
+
+// An estimated odometry scale absorbs what the odometry says of the size,
+// so bearings with odometry hold it no better than bearings alone: with Q_c
+// learned these runs ended with the odometry scale at 1.59 (10 map priors)
+// and 1.15 (50), 9.3 m and 3.3 m off. Q_c stays as given, and the scale
+// and the map's size come out right.
+TEST(VarianceComponentsTest, AnEstimatedOdometryScaleKeepsTheGivenQc) {
+  for (const int landmarks : {10, 50}) {
+    SCOPED_TRACE(landmarks);
+    SimulationOptions sim = PaperOptions(1);
+    sim.kind = ObservationType::kBearing;
+    sim.num_landmarks = landmarks;
+    const Dataset dataset = Simulated(sim);
+    SlamOptions options = WnoaDefaults();
+    options.problem.odometry_calibration.estimate = true;
+    const SlamResult result = Solved(dataset, options);
+    EXPECT_EQ(result.wnoa_options.position_qc, options.wnoa.position_qc);
+    EXPECT_NE(result.prior_scales_kept.find("it would shrink the scene"),
+              std::string::npos)
+        << result.prior_scales_kept;
+    EXPECT_NEAR(result.odometry_calibration.x(), 1.0, 0.02);
+    EXPECT_NEAR(MapSizeRatio(result, dataset), 1.0, 0.03);
+  }
 }
 
 // With odometry the RFF weights correct a WNOA solve of the same data,
