@@ -129,6 +129,7 @@ double ScaleInformation(const Dataset& dataset, const ProblemOptions& options) {
       ranges += o.range * o.range / (o.sigma_range * o.sigma_range);
     }
   }
+  ranges /= options.noise.range * options.noise.range;
   double odometry = 0.0;
   if (options.use_odometry) {
     for (const Odometry& o : dataset.odometry) {
@@ -136,6 +137,7 @@ double ScaleInformation(const Dataset& dataset, const ProblemOptions& options) {
                   o.dy * o.dy / (o.sigma_y * o.sigma_y);
     }
   }
+  odometry /= options.noise.odometry * options.noise.odometry;
   // A sensor whose scale is estimated passes a scaling of the scene to that
   // scale, held only by its prior: the two informations in series.
   const auto through_scale = [](double information, double scale_sigma) {
@@ -160,11 +162,6 @@ double ScaleInformation(const Dataset& dataset, const ProblemOptions& options) {
   return information;
 }
 
-double LearnedSizeShrink(double redundancy, double information) {
-  if (!(4.0 * redundancy < information)) return 1.0;
-  return (1.0 - std::sqrt(1.0 - 4.0 * redundancy / information)) / 2.0;
-}
-
 bool LearnScales(const Dataset& dataset,
                  std::shared_ptr<const MeanFunction> mean,
                  const ceres::Solver::Options& ceres_options,
@@ -177,7 +174,6 @@ bool LearnScales(const Dataset& dataset,
   // Whether the data hold the trajectory's size against the prior's pull
   // (below), and the scales as given, which it keeps where they do not.
   bool prior_scales_learned = true;
-  const double scale_information = ScaleInformation(dataset, settled->problem);
   double* position_scale = prior.PositionScale(settled);
   double* heading_scale = prior.HeadingScale(settled);
   const double given_position = *position_scale;
@@ -229,7 +225,9 @@ bool LearnScales(const Dataset& dataset,
   };
   Solved last;
   bool climbed = false;
-  for (int round = 0; round < kMaxScaleRounds; ++round) {
+  int rounds_cap = kMaxScaleRounds;
+  double largest_pull = 0.0;  // The position prior's, over the rounds.
+  for (int round = 0; round < rounds_cap; ++round) {
     VarianceComponents components;
     std::string why;
     if (!EstimateVarianceComponents(problem->get(), VarianceComponentOptions(),
@@ -238,36 +236,6 @@ bool LearnScales(const Dataset& dataset,
       // after a gap of days): the scales stay as they are, and say so.
       result->scales_not_learned = why;
       break;
-    }
-    // A learned Q_c shrinks the scene (LearnedSizeShrink); where by more
-    // than kSizeSigmas standard deviations of the size the data fix,
-    // 1 / sqrt(I), the data would reject that size: Q_c goes back to the
-    // given value (bearing-only maps ended at 0.64-0.89 of their size, with
-    // an estimated odometry scale at 0.5-0.9; docs/heldout.md).
-    const double redundancy =
-        components[static_cast<int>(VarianceGroup::kPriorPosition)].redundancy;
-    const double shrink = LearnedSizeShrink(redundancy, scale_information);
-    const double size_sigma = 1.0 / std::sqrt(scale_information);
-    const bool prior_scales_reset =
-        prior_scales_learned &&
-        (shrink >= 1.0 || shrink > kSizeSigmas * size_sigma);
-    if (prior_scales_reset) {
-      prior_scales_learned = false;
-      std::ostringstream why;
-      why << std::setprecision(3)
-          << "the data hold the trajectory's size too loosely for a learned "
-             "one (";
-      if (shrink >= 1.0) {
-        why << "it would shrink the scene without bound";
-      } else {
-        why << "it would shrink the scene by " << 100.0 * shrink
-            << "%, more than " << kSizeSigmas << " times the size's "
-            << 100.0 * size_sigma << "% standard deviation";
-      }
-      why << ": the prior's pull " << redundancy
-          << " against the data's scale information " << scale_information
-          << ")";
-      result->prior_scales_kept = why.str();
     }
     const Eigen::Vector2d prior_factors(
         components[static_cast<int>(VarianceGroup::kPriorPosition)].factor,
@@ -287,22 +255,10 @@ bool LearnScales(const Dataset& dataset,
     // before solved with, and the final solve.
     const double rounding =
         kEvidenceRounding * std::max(1.0, std::abs(last.log_evidence));
-    const bool evidence_fell =
-        gaussian && climbed && !prior_scales_reset &&
-        solved.log_evidence < last.log_evidence - rounding;
+    bool evidence_fell = gaussian && climbed &&
+                         solved.log_evidence < last.log_evidence - rounding;
     climbed = climbed || (round > 0 && solved.log_evidence > last.log_evidence);
     double largest_step = 0.0;
-    if (prior_scales_reset) {
-      // Back to the given scales: a jump, not a step of the climb, and a
-      // model to rescale and solve again where they had moved.
-      if (*position_scale != given_position ||
-          *heading_scale != given_heading) {
-        largest_step = std::numeric_limits<double>::infinity();
-      }
-      *position_scale = given_position;
-      *heading_scale = given_heading;
-      climbed = false;
-    }
     const std::size_t boundary_before = at_boundary.size();
     const double position_solved = *position_scale;
     const double heading_solved = *heading_scale;
@@ -392,9 +348,52 @@ bool LearnScales(const Dataset& dataset,
     result->prior_scale_factors =
         evidence_fell ? last.prior_factors : prior_factors;
     // Every factor but those stepping to the boundary within tolerance.
-    const bool others_settled =
+    bool others_settled =
         !evidence_fell && largest_step < std::log1p(kScaleTolerance);
     const bool boundary_step = at_boundary.size() > boundary_before;
+    // Where the rounds end, the size the learned scales leave. Scaling the
+    // positions about the start by 1 + s scales the position prior's
+    // whitened rows; at Q_c's fixed point their squares sum to the group's
+    // redundancy R, the prior's pull on s^2. With the data's I (at the
+    // noise levels learned: MRCLAM's odometry sigmas end 0.02-0.1 of the
+    // stated ones) the MAP's size s solves I (1 - s) = R / s, which has a
+    // root near 1 only where 4 R < I: beyond, a learned Q_c feeds on itself
+    // (a smaller trajectory, smaller accelerations, a smaller Q_c;
+    // bearing-only maps at 0.64-0.89 of their size, 0.5 with an estimated
+    // odometry scale, docs/heldout.md). The rounds then go on from Q_c as
+    // given, learning the noise factors only.
+    const bool ending =
+        others_settled || evidence_fell || round + 1 == rounds_cap;
+    largest_pull = std::max(
+        largest_pull,
+        components[static_cast<int>(VarianceGroup::kPriorPosition)].redundancy);
+    if (ending && prior_scales_learned) {
+      const double redundancy = largest_pull;
+      const double information = ScaleInformation(dataset, settled->problem);
+      if (4.0 * redundancy > information) {
+        prior_scales_learned = false;
+        std::ostringstream why;
+        why << std::setprecision(3)
+            << "the data hold the trajectory's size too loosely for a "
+               "learned one (the prior's pull "
+            << redundancy << " against the data's scale information "
+            << information << ", under 4 times the pull)";
+        result->prior_scales_kept = why.str();
+        if (*position_scale != given_position ||
+            *heading_scale != given_heading) {
+          // A jump, not a step of the climb: solved again from the given
+          // scales, with rounds of their own.
+          *position_scale = given_position;
+          *heading_scale = given_heading;
+          others_settled = false;
+          evidence_fell = false;
+          result->learning_evidence_fell = false;
+          result->noise_evidence_fell = false;
+          climbed = false;
+          rounds_cap = round + 1 + kMaxScaleRounds;
+        }
+      }
+    }
     if (others_settled && !boundary_step) {
       // Within tolerance: the prior keeps the scales it was solved with, so
       // that those reported are those the final solve uses (the noise
@@ -446,7 +445,7 @@ bool LearnScales(const Dataset& dataset,
     }
     note_radius();
   }
-  const bool capped = result->learning_rounds == kMaxScaleRounds &&
+  const bool capped = result->learning_rounds == rounds_cap &&
                       !result->learning_converged &&
                       !result->learning_evidence_fell;
   for (const VarianceGroup group : learned) {

@@ -45,23 +45,11 @@ std::array<double, kNumVarianceGroups> LogRowScales(
 // offset o from the start by s o, a bearing not at all. So
 //   I = sum r^2 / sigma_r^2 + sum (dx^2 / sigma_x^2 + dy^2 / sigma_y^2)
 //       + sum |o|^2 / sigma^2
-// over ranges, the odometry the problem uses, and map and pose priors. A
-// sensor whose scale is estimated under a prior of sigma_s counts
-// I / (1 + I sigma_s^2): its scale absorbs the scaling but for that prior.
+// over ranges, the odometry the problem uses, and map and pose priors, the
+// sigmas times the options' noise factors. A sensor whose scale is estimated
+// under a prior of sigma_s counts I / (1 + I sigma_s^2): its scale absorbs
+// the scaling but for that prior.
 double ScaleInformation(const Dataset& dataset, const ProblemOptions& options);
-
-// How much learned prior scales shrink the scene about the start at their
-// fixed point, with R the position prior's redundancy and I =
-// ScaleInformation. Scaling positions by s scales the prior's whitened rows,
-// whose squares sum to R at Q_c's fixed point, and the accelerations Q_c
-// follows: the MAP's size solves I (1 - s) = R / s, with the root near 1 at
-// s = (1 + sqrt(1 - 4 R / I)) / 2. Returns 1 - s, or 1 where 4 R >= I
-// leaves no root (a learned scale feeds on itself to zero).
-double LearnedSizeShrink(double redundancy, double information);
-
-// A learned prior scale is kept only where its shrink stays within this many
-// standard deviations of the size the data fix (1 / sqrt(I)).
-inline constexpr double kSizeSigmas = 2.0;
 
 // Learns the scales of the trajectory prior (WNOA Q_c, RFF kernel
 // variances) of x, y and theta and, where `noise`, the factors on the sigmas
@@ -73,10 +61,10 @@ inline constexpr double kSizeSigmas = 2.0;
 // several times tighter than stated (docs/heldout.md). `loose`: the problem
 // was solved at kPlacingTolerance only. A correction to the mean whose
 // factor is under 0.01 (its variance at zero, as far as the data tell)
-// takes one tenfold step down and is learned no further. From the round
-// the data hold the trajectory's size too loosely for learned prior scales
-// (LearnedSizeShrink beyond kSizeSigmas) the prior's scales go back to the
-// given ones and only the noise factors are learned.
+// takes one tenfold step down and is learned no further. Where at the
+// rounds' end the data hold the trajectory's size too loosely for the
+// learned prior scales (ScaleInformation against the prior's pull), the
+// rounds go on from the given scales and learn only the noise factors.
 bool LearnScales(const Dataset& dataset,
                  std::shared_ptr<const MeanFunction> mean,
                  const ceres::Solver::Options& ceres_options,
