@@ -225,8 +225,35 @@ bool LearnScales(const Dataset& dataset,
   };
   Solved last;
   bool climbed = false;
+  // Scaling the positions about the start by 1 + s scales the position
+  // prior's whitened rows; at Q_c's fixed point their squares sum to the
+  // group's redundancy R, the prior's pull on s^2. With the data's I the
+  // MAP's size s then solves I (1 - s) = R / s (the accelerations and Q_c
+  // follow s^2), which has a root near 1 only where 4 R < I: beyond, a
+  // learned Q_c feeds on itself (a smaller trajectory, smaller
+  // accelerations, a smaller Q_c; bearing-only maps at 0.64-0.89 of their
+  // size, 0.5 with an estimated odometry scale, docs/heldout.md). Q_c then
+  // goes back to the given value, and only the noise factors are learned.
+  auto note_kept = [&](double pull, double information) {
+    prior_scales_learned = false;
+    std::ostringstream why;
+    why << std::setprecision(3)
+        << "the data hold the trajectory's size too loosely for a learned "
+           "one (the prior's pull "
+        << pull << " against the data's scale information " << information
+        << ", under 4 times the pull)";
+    result->prior_scales_kept = why.str();
+  };
+  // Each round the data at face value (the stated sigmas, every sensor's
+  // scale as known) must hold the size against the round's pull: they can
+  // only overstate it. A collapse lowers the pull as it goes (the paper's
+  // bearing-only sets: R 218 -> 147), so the settled rounds alone miss it.
+  ProblemOptions face_value = settled->problem;
+  face_value.noise = NoiseScales();
+  face_value.range_calibration.estimate = false;
+  face_value.odometry_calibration.estimate = false;
+  const double face_value_information = ScaleInformation(dataset, face_value);
   int rounds_cap = kMaxScaleRounds;
-  double largest_pull = 0.0;  // The position prior's, over the rounds.
   for (int round = 0; round < rounds_cap; ++round) {
     VarianceComponents components;
     std::string why;
@@ -237,6 +264,11 @@ bool LearnScales(const Dataset& dataset,
       result->scales_not_learned = why;
       break;
     }
+    const double pull =
+        components[static_cast<int>(VarianceGroup::kPriorPosition)].redundancy;
+    const bool prior_scales_reset =
+        prior_scales_learned && 4.0 * pull > face_value_information;
+    if (prior_scales_reset) note_kept(pull, face_value_information);
     const Eigen::Vector2d prior_factors(
         components[static_cast<int>(VarianceGroup::kPriorPosition)].factor,
         components[static_cast<int>(VarianceGroup::kPriorHeading)].factor);
@@ -255,10 +287,21 @@ bool LearnScales(const Dataset& dataset,
     // before solved with, and the final solve.
     const double rounding =
         kEvidenceRounding * std::max(1.0, std::abs(last.log_evidence));
-    bool evidence_fell = gaussian && climbed &&
+    bool evidence_fell = gaussian && climbed && !prior_scales_reset &&
                          solved.log_evidence < last.log_evidence - rounding;
     climbed = climbed || (round > 0 && solved.log_evidence > last.log_evidence);
     double largest_step = 0.0;
+    if (prior_scales_reset) {
+      // Back to the given scales: a jump, not a step of the climb, and a
+      // model to rescale and solve again where they had moved.
+      if (*position_scale != given_position ||
+          *heading_scale != given_heading) {
+        largest_step = std::numeric_limits<double>::infinity();
+      }
+      *position_scale = given_position;
+      *heading_scale = given_heading;
+      climbed = false;
+    }
     const std::size_t boundary_before = at_boundary.size();
     const double position_solved = *position_scale;
     const double heading_solved = *heading_scale;
@@ -351,47 +394,30 @@ bool LearnScales(const Dataset& dataset,
     bool others_settled =
         !evidence_fell && largest_step < std::log1p(kScaleTolerance);
     const bool boundary_step = at_boundary.size() > boundary_before;
-    // Where the rounds end, the size the learned scales leave. Scaling the
-    // positions about the start by 1 + s scales the position prior's
-    // whitened rows; at Q_c's fixed point their squares sum to the group's
-    // redundancy R, the prior's pull on s^2. With the data's I (at the
-    // noise levels learned: MRCLAM's odometry sigmas end 0.02-0.1 of the
-    // stated ones) the MAP's size s solves I (1 - s) = R / s, which has a
-    // root near 1 only where 4 R < I: beyond, a learned Q_c feeds on itself
-    // (a smaller trajectory, smaller accelerations, a smaller Q_c;
-    // bearing-only maps at 0.64-0.89 of their size, 0.5 with an estimated
-    // odometry scale, docs/heldout.md). The rounds then go on from Q_c as
-    // given, learning the noise factors only.
+    // Where the rounds end, the same with the information the data carry
+    // at the noise levels learned (MRCLAM's odometry sigmas end 0.02-0.1 of
+    // the stated ones), a sensor whose scale is estimated counted through
+    // its scale's prior (ScaleInformation), against the learned scales'
+    // pull. Past it the rounds go on from the given scales.
     const bool ending =
         others_settled || evidence_fell || round + 1 == rounds_cap;
-    largest_pull = std::max(
-        largest_pull,
-        components[static_cast<int>(VarianceGroup::kPriorPosition)].redundancy);
-    if (ending && prior_scales_learned) {
-      const double redundancy = largest_pull;
-      const double information = ScaleInformation(dataset, settled->problem);
-      if (4.0 * redundancy > information) {
-        prior_scales_learned = false;
-        std::ostringstream why;
-        why << std::setprecision(3)
-            << "the data hold the trajectory's size too loosely for a "
-               "learned one (the prior's pull "
-            << redundancy << " against the data's scale information "
-            << information << ", under 4 times the pull)";
-        result->prior_scales_kept = why.str();
-        if (*position_scale != given_position ||
-            *heading_scale != given_heading) {
-          // A jump, not a step of the climb: solved again from the given
-          // scales, with rounds of their own.
-          *position_scale = given_position;
-          *heading_scale = given_heading;
-          others_settled = false;
-          evidence_fell = false;
-          result->learning_evidence_fell = false;
-          result->noise_evidence_fell = false;
-          climbed = false;
-          rounds_cap = round + 1 + kMaxScaleRounds;
-        }
+    const double learned_information =
+        ending && prior_scales_learned
+            ? ScaleInformation(dataset, settled->problem)
+            : 0.0;
+    if (ending && prior_scales_learned && 4.0 * pull > learned_information) {
+      note_kept(pull, learned_information);
+      if (*position_scale != given_position ||
+          *heading_scale != given_heading) {
+        // A jump, not a step of the climb, with rounds of its own.
+        *position_scale = given_position;
+        *heading_scale = given_heading;
+        others_settled = false;
+        evidence_fell = false;
+        result->learning_evidence_fell = false;
+        result->noise_evidence_fell = false;
+        climbed = false;
+        rounds_cap = round + 1 + kMaxScaleRounds;
       }
     }
     if (others_settled && !boundary_step) {
