@@ -167,6 +167,9 @@ void PrintSlamSummary(const SlamOptions& options, const SlamResult& result,
          << result.start_heading.heading << " rad (prior "
          << result.start_heading.prior_heading << ")";
   }
+  if (!result.start_prior_scales_kept.empty()) {
+    *out << "; its Q_c kept as given: " << result.start_prior_scales_kept;
+  }
   *out << "\n";
   const bool depth = result.range_bearing_ranges == "depth";
   if (depth) {
@@ -271,6 +274,8 @@ void WriteSummaryJson(const SlamOptions& options, const SlamResult& result,
       << ",\n"
       << "  \"prior_scales_kept\": " << JsonString(result.prior_scales_kept)
       << ",\n"
+      << "  \"start_prior_scales_kept\": "
+      << JsonString(result.start_prior_scales_kept) << ",\n"
       << "  \"prior_scale_factors\": ["
       << FormatNumber(result.prior_scale_factors[0]) << ", "
       << FormatNumber(result.prior_scale_factors[1]) << "],\n"

@@ -89,6 +89,8 @@ struct SlamResult {
   // were learned (the data hold the trajectory's size too loosely,
   // LearnScales); empty otherwise.
   std::string prior_scales_kept;
+  // The same for the WNOA solve a feature prior's solve started from.
+  std::string start_prior_scales_kept;
   Eigen::Vector2d prior_scale_factors = Eigen::Vector2d::Ones();
   // The factors on the data's sigmas the solve ended with: learned with the
   // WNOA prior's scales (and passed on to an RFF solve about it), else 1.

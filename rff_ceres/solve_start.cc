@@ -127,6 +127,7 @@ std::shared_ptr<const MeanFunction> BuildMean(
       *wnoa_mean_solve = std::move(wnoa);
     } else {
       warm->start.poses = wnoa.trajectory;
+      result->start_prior_scales_kept = wnoa.prior_scales_kept;
     }
   }
   if (!mean) {

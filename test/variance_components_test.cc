@@ -497,6 +497,16 @@ TEST(VarianceComponentsTest, BearingsAloneKeepTheGivenQcWhereTheSizeIsLoose) {
   EXPECT_EQ(rff_summary.str().find("noise factors"), std::string::npos)
       << rff_summary.str();
 
+  // The RFF default starts from such a WNOA solve, and says so.
+  const SlamResult rff_solved = Solved(dataset, SlamOptions());
+  std::ostringstream rff_solved_summary;
+  PrintSlamSummary(SlamOptions(), rff_solved, &rff_solved_summary);
+  EXPECT_NE(rff_solved_summary.str().find(
+                "initial trajectory from the wnoa; its Q_c kept as given: "
+                "the data hold"),
+            std::string::npos)
+      << rff_solved_summary.str();
+
   sim.landmark_prior_sigma = 0.1;
   const SlamResult mapped = Solved(Simulated(sim), options);
   EXPECT_TRUE(mapped.prior_scales_kept.empty()) << mapped.prior_scales_kept;
