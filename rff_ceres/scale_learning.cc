@@ -395,20 +395,17 @@ bool LearnScales(const Dataset& dataset,
         !evidence_fell && largest_step < std::log1p(kScaleTolerance);
     const bool boundary_step = at_boundary.size() > boundary_before;
     // Where the rounds end, the same with the information the data carry
-    // at the noise levels learned (MRCLAM's odometry sigmas end 0.02-0.1 of
+    // at the noise levels learned (MRCLAM's odometry sigmas end 0.02-0.5 of
     // the stated ones), a sensor whose scale is estimated counted through
     // its scale's prior (ScaleInformation), against the learned scales'
     // pull. Past it the rounds go on from the given scales.
     const bool ending =
         others_settled || evidence_fell || round + 1 == rounds_cap;
-    const double learned_information =
-        ending && prior_scales_learned
-            ? ScaleInformation(dataset, settled->problem)
-            : 0.0;
-    if (ending && prior_scales_learned && 4.0 * pull > learned_information) {
-      note_kept(pull, learned_information);
-      if (*position_scale != given_position ||
-          *heading_scale != given_heading) {
+    if (ending && prior_scales_learned) {
+      const double information = ScaleInformation(dataset, settled->problem);
+      if (4.0 * pull > information) note_kept(pull, information);
+      if (!prior_scales_learned && (*position_scale != given_position ||
+                                    *heading_scale != given_heading)) {
         // A jump, not a step of the climb, with rounds of its own.
         *position_scale = given_position;
         *heading_scale = given_heading;

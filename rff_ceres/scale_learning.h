@@ -61,10 +61,12 @@ double ScaleInformation(const Dataset& dataset, const ProblemOptions& options);
 // several times tighter than stated (docs/heldout.md). `loose`: the problem
 // was solved at kPlacingTolerance only. A correction to the mean whose
 // factor is under 0.01 (its variance at zero, as far as the data tell)
-// takes one tenfold step down and is learned no further. Where at the
-// rounds' end the data hold the trajectory's size too loosely for the
-// learned prior scales (ScaleInformation against the prior's pull), the
-// rounds go on from the given scales and learn only the noise factors.
+// takes one tenfold step down and is learned no further. Where the data
+// hold the trajectory's size too loosely for learned prior scales
+// (ScaleInformation against the prior's pull: each round at face value,
+// and where the rounds end at the noise levels learned), the prior's
+// scales go back to the given ones and the rounds learn only the noise
+// factors.
 bool LearnScales(const Dataset& dataset,
                  std::shared_ptr<const MeanFunction> mean,
                  const ceres::Solver::Options& ceres_options,
