@@ -244,6 +244,16 @@ bool LearnScales(const Dataset& dataset,
         << ", under 4 times the pull)";
     result->prior_scales_kept = why.str();
   };
+  // Back to the given scales: a jump, not a step of the climb. Returns
+  // whether they had moved, and so need a model rescaled and solved again.
+  auto back_to_given = [&] {
+    const bool moved =
+        *position_scale != given_position || *heading_scale != given_heading;
+    *position_scale = given_position;
+    *heading_scale = given_heading;
+    climbed = false;
+    return moved;
+  };
   // Each round the data at face value (the stated sigmas, every sensor's
   // scale as known) must hold the size against the round's pull: they can
   // only overstate it. A collapse lowers the pull as it goes (the paper's
@@ -291,16 +301,8 @@ bool LearnScales(const Dataset& dataset,
                          solved.log_evidence < last.log_evidence - rounding;
     climbed = climbed || (round > 0 && solved.log_evidence > last.log_evidence);
     double largest_step = 0.0;
-    if (prior_scales_reset) {
-      // Back to the given scales: a jump, not a step of the climb, and a
-      // model to rescale and solve again where they had moved.
-      if (*position_scale != given_position ||
-          *heading_scale != given_heading) {
-        largest_step = std::numeric_limits<double>::infinity();
-      }
-      *position_scale = given_position;
-      *heading_scale = given_heading;
-      climbed = false;
+    if (prior_scales_reset && back_to_given()) {
+      largest_step = std::numeric_limits<double>::infinity();
     }
     const std::size_t boundary_before = at_boundary.size();
     const double position_solved = *position_scale;
@@ -404,16 +406,12 @@ bool LearnScales(const Dataset& dataset,
     if (ending && prior_scales_learned) {
       const double information = ScaleInformation(dataset, settled->problem);
       if (4.0 * pull > information) note_kept(pull, information);
-      if (!prior_scales_learned && (*position_scale != given_position ||
-                                    *heading_scale != given_heading)) {
-        // A jump, not a step of the climb, with rounds of its own.
-        *position_scale = given_position;
-        *heading_scale = given_heading;
+      if (!prior_scales_learned && back_to_given()) {
+        // Rounds of its own from there.
         others_settled = false;
         evidence_fell = false;
         result->learning_evidence_fell = false;
         result->noise_evidence_fell = false;
-        climbed = false;
         rounds_cap = round + 1 + kMaxScaleRounds;
       }
     }
