@@ -26,7 +26,7 @@ for kind in rb range bearing; do
                  --flagfile="$root/configs/$config${SUFFIX:-}.flags" \
                  --dataset="$file" "$@" 2>/dev/null); then
           results+=$(echo "$out" | awk '/^APE translation/ {a = $4}
-                                        /s total/ {t = $6}
+                                        / s total$/ {t = $(NF - 2)}
                                         END {print a, t}')$'\n'
         else
           failures=$((failures + 1))
