@@ -137,6 +137,11 @@ bool IncrementalSolver::SolveUpdate(double now, int num_measurements,
   update.t = std::min(now, data_end_);
   update.num_measurements = num_measurements;
   update.active_blocks = SetActiveBlocks(now);
+  // A fixed-lag smoother: what frozen blocks' residuals still say of the
+  // landmarks and calibrations, as a prior (each update costs the window,
+  // not the run).
+  slam_->FoldFrozenResiduals();
+  update.folded_residuals = slam_->num_folded();
   // Settled afresh: RunSolve records its own choice for this update.
   ChooseLinearSolver(options_.solver, *model_, &ceres_options_, result_);
   if (!RunSolve(options_.solver, ceres_options_, slam_, result_, error)) {
@@ -151,7 +156,25 @@ bool IncrementalSolver::SolveUpdate(double now, int num_measurements,
   result_->updates.push_back(update);
   VLOG(1) << "update at t = " << now << ": " << update.num_measurements
           << " measurements, " << update.active_blocks << " active blocks, "
-          << update.iterations << " iterations, " << update.seconds << " s";
+          << update.iterations << " iterations, " << update.folded_residuals
+          << " folded, " << update.seconds << " s";
+  return true;
+}
+
+bool IncrementalSolver::RebuildWhole(std::string* error) {
+  auto whole = std::make_unique<SlamProblem>(model_, options_.problem);
+  whole->set_range_calibration(slam_->range_calibration());
+  whole->set_odometry_calibration(slam_->odometry_calibration());
+  if (!whole->Build(dataset_, slam_->landmarks(), error)) return false;
+  *problem_ = std::move(whole);
+  slam_ = problem_->get();
+  ceres_problem_ = slam_->problem();
+  // Blocks no data touched stay as the updates left them.
+  for (int b = 0; b < model_->num_blocks(); ++b) {
+    if (!InUse(b)) {
+      ceres_problem_->SetParameterBlockConstant(model_->mutable_block(b));
+    }
+  }
   return true;
 }
 
@@ -185,6 +208,7 @@ bool IncrementalSolver::Solve(std::string* error) {
              " has no PRIOR_LANDMARK and its observations do not locate it";
     return false;
   }
+  if (slam_->num_folded() > 0 && !RebuildWhole(error)) return false;
   // Everything the data touched is a variable again, for the covariance.
   for (int b = 0; b < model_->num_blocks(); ++b) {
     if (InUse(b)) {

@@ -2,7 +2,9 @@
 // re-solve after every K of them. Trajectory blocks enter the problem (become
 // variable) when a residual first touches them and are frozen once no
 // residual has touched them for `lag` seconds; landmarks enter when their
-// observations so far locate them.
+// observations so far locate them. Residuals of frozen blocks are folded into
+// a prior on the landmarks and calibrations they move (a fixed-lag smoother,
+// SlamProblem::FoldFrozenResiduals).
 #ifndef RFF_CERES_INCREMENTAL_SOLVER_H_
 #define RFF_CERES_INCREMENTAL_SOLVER_H_
 
@@ -66,6 +68,9 @@ class IncrementalSolver {
   // Adds the priors and odometry up to `now` and the landmarks that can be
   // located, then solves the blocks in use.
   bool SolveUpdate(double now, int num_measurements, std::string* error);
+  // The whole problem over the last update's values, the folded residuals
+  // back in place, for covariances and reports.
+  bool RebuildWhole(std::string* error);
 
   const Dataset& dataset_;
   const SlamOptions& options_;

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstring>
 #include <string_view>
+#include <unordered_set>
 
 #include "Eigen/Eigenvalues"
 #include "costs/calibrated_odometry_cost.h"
@@ -588,6 +589,96 @@ std::vector<VarianceGroup> SlamProblem::RowGroups(
     }
   }
   return rows;
+}
+
+int SlamProblem::FoldFrozenResiduals() {
+  // Timed blocks: a shared one (a rotation of the mean) moves every pose.
+  std::unordered_set<const double*> trajectory;
+  for (int b = 0; b < model_->num_blocks(); ++b) {
+    if (!model_->IsSharedBlock(b)) trajectory.insert(model_->mutable_block(b));
+  }
+  // In the problem's (insertion) order: the sums are reproducible.
+  std::vector<ceres::ResidualBlockId> ids;
+  problem_->GetResidualBlocks(&ids);
+  std::vector<double*> blocks;
+  std::vector<int> sizes;
+  std::vector<std::vector<double>> jacobian_rows;
+  std::vector<double*> jacobians;
+  std::vector<const double*> folded_jacobians;
+  std::vector<double> residuals;
+  std::set<std::pair<bool, LandmarkId>> changed;
+  for (const ceres::ResidualBlockId id : ids) {
+    const auto source = sources_.find(id);
+    // Timed data only: priors on landmarks and calibrations stay exact.
+    if (source == sources_.end() || !source->second.has_time) continue;
+    problem_->GetParameterBlocksForResidualBlock(id, &blocks);
+    bool timed = false, frozen = true, moves = false;
+    for (double* block : blocks) {
+      const bool constant = problem_->IsParameterBlockConstant(block);
+      if (trajectory.count(block) > 0) {
+        timed = true;
+        frozen = frozen && constant;
+      } else {
+        moves = moves || !constant;
+      }
+    }
+    if (!timed || !frozen || !moves) continue;
+    const ceres::CostFunction* cost =
+        problem_->GetCostFunctionForResidualBlock(id);
+    const int rows = cost->num_residuals();
+    sizes = cost->parameter_block_sizes();
+    jacobian_rows.resize(blocks.size());
+    jacobians.assign(blocks.size(), nullptr);
+    folded_jacobians.assign(blocks.size(), nullptr);
+    for (std::size_t j = 0; j < blocks.size(); ++j) {
+      if (problem_->IsParameterBlockConstant(blocks[j])) continue;
+      jacobian_rows[j].resize(static_cast<std::size_t>(rows) * sizes[j]);
+      jacobians[j] = jacobian_rows[j].data();
+      folded_jacobians[j] = jacobians[j];
+    }
+    residuals.resize(rows);
+    double value = 0.0;
+    // Left as it is where Ceres cannot evaluate it (the solve reports it).
+    if (!problem_->EvaluateResidualBlock(id, /*apply_loss_function=*/true,
+                                         &value, residuals.data(),
+                                         jacobians.data())) {
+      continue;
+    }
+    const std::pair<bool, LandmarkId> key(source->second.has_landmark,
+                                          source->second.landmark);
+    folded_[key].prior.Add(blocks, sizes, folded_jacobians, residuals.data(),
+                           rows, value);
+    changed.insert(key);
+    if (source->second.has_landmark) {
+      std::vector<ceres::ResidualBlockId>& of_landmark =
+          landmark_residuals_[source->second.landmark];
+      of_landmark.erase(std::find(of_landmark.begin(), of_landmark.end(), id));
+    }
+    sources_.erase(source);
+    problem_->RemoveResidualBlock(id);
+  }
+  if (changed.empty()) return 0;
+  for (const auto& key : changed) {
+    Folded& f = folded_[key];
+    if (f.block != nullptr) {
+      sources_.erase(f.block);
+      problem_->RemoveResidualBlock(f.block);
+    }
+    f.block = problem_->AddResidualBlock(f.prior.MakeCost().release(), nullptr,
+                                         f.prior.blocks());
+    Remember(f.block, {"folded past", 0.0, 0.0, 0, false, /*has_time=*/false});
+  }
+  const int before = num_folded_;
+  num_folded_ = 0;
+  for (const auto& [key, f] : folded_) num_folded_ += f.prior.num_folded();
+  // Costs were deleted: none can follow new scales, and the layouts and a
+  // kept linearisation describe residuals that are gone.
+  observation_weights_.clear();
+  odometry_weights_.clear();
+  weighted_ = false;
+  layout_.reset();
+  DropLinearization();
+  return num_folded_ - before;
 }
 
 std::shared_ptr<ceres::ParameterBlockOrdering> SlamProblem::Ordering() {

@@ -21,6 +21,7 @@
 #include "ceres/problem.h"
 #include "costs/noise_weighted.h"
 #include "rff_ceres/banded_problem.h"
+#include "rff_ceres/folded_prior.h"
 #include "rff_ceres/odometry_preintegration.h"
 #include "rff_ceres/trajectory_model.h"
 #include "rff_ceres/types.h"
@@ -249,6 +250,15 @@ class SlamProblem {
   // residuals (through the robust loss if `apply_loss`); zero if unknown.
   Eigen::Matrix2d LandmarkInformation(LandmarkId id, bool apply_loss);
 
+  // Fixed-lag smoothing: every data residual whose timed trajectory blocks
+  // are all constant, and which still moves another block (its landmark, a
+  // calibration, the mean's rotation), leaves the problem for a FoldedPrior
+  // cost on those blocks, linearised where they are now. Returns how many it
+  // folded; a problem with folded residuals is no longer the data's whole
+  // problem (whoever folds builds that again for covariances and reports).
+  int FoldFrozenResiduals();
+  int num_folded() const { return num_folded_; }
+
   // Landmarks in group 0 (eliminated first), trajectory blocks in group 1,
   // the model's shared blocks (a rotation of its mean) in group 2, the range
   // and odometry calibrations in group 3. Null without landmarks: Ceres then
@@ -371,6 +381,15 @@ class SlamProblem {
   std::set<LandmarkId> has_prior_;
   Eigen::Vector2d range_calibration_ = Eigen::Vector2d(1.0, 0.0);
   Eigen::Vector2d odometry_calibration_ = Eigen::Vector2d(1.0, 1.0);
+  // One folded prior per landmark (and one for residuals without one): no
+  // residual couples two landmarks, so neither do these, and the landmarks
+  // stay an independent set for a Schur solver.
+  struct Folded {
+    FoldedPrior prior;
+    ceres::ResidualBlockId block = nullptr;
+  };
+  std::map<std::pair<bool, LandmarkId>, Folded> folded_;
+  int num_folded_ = 0;
 };
 
 }  // namespace rff

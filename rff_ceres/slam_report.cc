@@ -207,7 +207,13 @@ void PrintSlamSummary(const SlamOptions& options, const SlamResult& result,
     UpdateTimes(result, &mean, &max);
     *out << "  incremental  " << result.updates.size() << " updates (every "
          << options.incremental.every << " measurements), " << mean * 1e3
-         << " ms mean, " << max * 1e3 << " ms max per update\n";
+         << " ms mean, " << max * 1e3 << " ms max per update";
+    if (result.updates.back().folded_residuals > 0) {
+      *out << "; " << result.updates.back().folded_residuals
+           << " residuals of frozen blocks folded into a prior on the blocks "
+              "they move";
+    }
+    *out << "\n";
   }
   *out << "  losses       observations " << options.problem.loss.name;
   if (result.loss != options.problem.loss.name) *out << " -> " << result.loss;
@@ -387,7 +393,10 @@ void WriteSummaryJson(const SlamOptions& options, const SlamResult& result,
       << "  \"incremental_every\": " << options.incremental.every << ",\n"
       << "  \"incremental_updates\": " << result.updates.size() << ",\n"
       << "  \"update_seconds_mean\": " << FormatNumber(update_mean) << ",\n"
-      << "  \"update_seconds_max\": " << FormatNumber(update_max) << "\n"
+      << "  \"update_seconds_max\": " << FormatNumber(update_max) << ",\n"
+      << "  \"folded_residuals\": "
+      << (result.updates.empty() ? 0 : result.updates.back().folded_residuals)
+      << "\n"
       << "}\n";
 }
 

@@ -33,6 +33,8 @@ struct IncrementalUpdate {
   int num_measurements = 0;  // Range/bearing measurements so far.
   int iterations = 0;
   int active_blocks = 0;  // Trajectory blocks not frozen.
+  // Residuals of frozen blocks folded into the past's prior so far.
+  int folded_residuals = 0;
   double seconds = 0.0;   // Wall time of the update (building + solving).
 };
 

@@ -946,6 +946,21 @@ TEST(SlamSolverTest, IncrementalModeTracksTheBatchSolution) {
   const int total_blocks = 9;
   EXPECT_LT(incremental.updates.back().active_blocks, total_blocks);
   EXPECT_LT(ApeTranslation(dataset, incremental), 0.8) << "batch " << batch_ape;
+  // The frozen segments' residuals were folded into a prior as the updates
+  // went (the last update, past the data's end, freezes every block)...
+  const auto folded_before_the_end =
+      incremental.updates[incremental.updates.size() - 2].folded_residuals;
+  EXPECT_GT(folded_before_the_end, 0);
+  EXPECT_LT(folded_before_the_end, 600);
+  // ...and the problem reported on is the data's whole one: every residual
+  // of every kind, as the batch solve's.
+  ASSERT_EQ(incremental.quality.kinds.size(), batch.quality.kinds.size());
+  for (std::size_t k = 0; k < batch.quality.kinds.size(); ++k) {
+    EXPECT_EQ(incremental.quality.kinds[k].kind, batch.quality.kinds[k].kind);
+    EXPECT_EQ(incremental.quality.kinds[k].residuals,
+              batch.quality.kinds[k].residuals)
+        << batch.quality.kinds[k].kind;
+  }
 }
 
 // Incremental WNOA updates with frozen states (residuals on constant
