@@ -479,6 +479,7 @@ bool SlamProblem::FindNonFinite(std::string* description) {
   std::vector<double> residuals;
   std::vector<std::vector<double>> jacobians;
   std::vector<double*> jacobian_pointers;
+  std::vector<double*> blocks;
   for (const ceres::ResidualBlockId id : ids) {
     const ceres::CostFunction* cost =
         problem_->GetCostFunctionForResidualBlock(id);
@@ -486,9 +487,13 @@ bool SlamProblem::FindNonFinite(std::string* description) {
     residuals.assign(cost->num_residuals(), 0.0);
     jacobians.resize(sizes.size());
     jacobian_pointers.resize(sizes.size());
+    problem_->GetParameterBlocksForResidualBlock(id, &blocks);
     for (std::size_t i = 0; i < sizes.size(); ++i) {
-      jacobians[i].assign(cost->num_residuals() * sizes[i], 0.0);
-      jacobian_pointers[i] = jacobians[i].data();
+      // Ceres refuses a Jacobian of a constant block (frozen ones, in the
+      // incremental mode): that refusal is no non-finite value.
+      const bool constant = problem_->IsParameterBlockConstant(blocks[i]);
+      jacobians[i].assign(constant ? 0 : cost->num_residuals() * sizes[i], 0.0);
+      jacobian_pointers[i] = constant ? nullptr : jacobians[i].data();
     }
     double cost_value = 0.0;
     const bool ok = problem_->EvaluateResidualBlock(

@@ -1204,6 +1204,40 @@ TEST(SlamSolverTest, OverflowingResidualIsNamed) {
   EXPECT_THAT(error, HasSubstr("of landmark " + std::to_string(o.id)));
 }
 
+// Frozen blocks (the incremental mode's) have no Jacobian to give: Ceres's
+// refusal is no non-finite residual, and an overflow is still named.
+TEST(SlamProblemTest, FrozenBlocksAreNotTakenForNonFiniteResiduals) {
+  Dataset dataset = PaperDataset(5, 40, 8, 3);
+  SlamOptions options;
+  options.prior = "wnoa";
+  std::string error;
+  const std::shared_ptr<const MeanFunction> mean =
+      BuildPriorMean("constant", dataset, &error);
+  ASSERT_NE(mean, nullptr) << error;
+  std::map<LandmarkId, Eigen::Vector2d> landmarks;
+  for (const LandmarkPrior& prior : dataset.landmark_priors) {
+    landmarks[prior.id] = Eigen::Vector2d(prior.x, prior.y);
+  }
+  auto model = CreateTrajectoryModel(dataset, options, mean, &error);
+  ASSERT_NE(model, nullptr) << error;
+  auto frozen_problem = [&](const Dataset& data) {
+    auto problem = std::make_unique<SlamProblem>(model.get(), options.problem);
+    EXPECT_TRUE(problem->Build(data, landmarks, &error)) << error;
+    for (int b = 0; b < model->num_blocks() / 2; ++b) {
+      problem->problem()->SetParameterBlockConstant(model->mutable_block(b));
+    }
+    return problem;
+  };
+  std::string culprit;
+  EXPECT_FALSE(frozen_problem(dataset)->FindNonFinite(&culprit)) << culprit;
+  Observation& o = dataset.observations[2];  // On a frozen state.
+  o.range = 1e300;
+  o.sigma_range = 1e-300;
+  EXPECT_TRUE(frozen_problem(dataset)->FindNonFinite(&culprit));
+  EXPECT_THAT(culprit, HasSubstr("of landmark " + std::to_string(o.id)));
+  EXPECT_THAT(culprit, HasSubstr("is not finite"));
+}
+
 // A caller's abort (a Python Ctrl-C) stops the solve at the next iteration
 // and fails it; a solve never asked to stop is not changed by the check.
 TEST(SlamSolverTest, ShouldAbortStopsTheSolve) {
