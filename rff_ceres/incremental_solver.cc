@@ -175,6 +175,8 @@ bool IncrementalSolver::RebuildWhole(std::string* error) {
       ceres_problem_->SetParameterBlockConstant(model_->mutable_block(b));
     }
   }
+  // The summary counts the data's problem, not the last update's window.
+  result_->summary.num_residual_blocks = ceres_problem_->NumResidualBlocks();
   return true;
 }
 

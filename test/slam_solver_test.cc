@@ -954,6 +954,8 @@ TEST(SlamSolverTest, IncrementalModeTracksTheBatchSolution) {
   EXPECT_LT(folded_before_the_end, 600);
   // ...and the problem reported on is the data's whole one: every residual
   // of every kind, as the batch solve's.
+  EXPECT_EQ(incremental.summary.num_residual_blocks,
+            batch.summary.num_residual_blocks);
   ASSERT_EQ(incremental.quality.kinds.size(), batch.quality.kinds.size());
   for (std::size_t k = 0; k < batch.quality.kinds.size(); ++k) {
     EXPECT_EQ(incremental.quality.kinds[k].kind, batch.quality.kinds[k].kind);
