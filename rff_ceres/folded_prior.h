@@ -5,8 +5,8 @@
 //   q(x) = sum_i [c_i + g_i^T (x - x_i) + 1/2 (x - x_i)^T J_i^T J_i (x - x_i)],
 //   g_i = J_i^T r_i,
 //
-// with r_i and J_i the residual and Jacobian as Ceres corrects them for the
-// robust loss (Triggs et al.), c_i its cost. Summed about the blocks' first
+// with r_i and J_i the residual and Jacobian (weighted by the caller, e.g.
+// by a robust loss's rho'), c_i its cost. Summed about the blocks' first
 // values x_ref, so that large coordinates do not cancel.
 #ifndef RFF_CERES_FOLDED_PRIOR_H_
 #define RFF_CERES_FOLDED_PRIOR_H_

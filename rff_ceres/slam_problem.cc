@@ -628,6 +628,13 @@ int SlamProblem::FoldFrozenResiduals() {
       }
     }
     if (!timed || !frozen || !moves) continue;
+    // A landmark its sightings alone locate can move far after the first
+    // of them freeze (bearing-only, it diverged held where it was first
+    // seen): its residuals stay exact.
+    if (source->second.has_landmark &&
+        !has_landmark_prior(source->second.landmark)) {
+      continue;
+    }
     const ceres::CostFunction* cost =
         problem_->GetCostFunctionForResidualBlock(id);
     const int rows = cost->num_residuals();
@@ -644,10 +651,25 @@ int SlamProblem::FoldFrozenResiduals() {
     residuals.resize(rows);
     double value = 0.0;
     // Left as it is where Ceres cannot evaluate it (the solve reports it).
-    if (!problem_->EvaluateResidualBlock(id, /*apply_loss_function=*/true,
+    if (!problem_->EvaluateResidualBlock(id, /*apply_loss_function=*/false,
                                          &value, residuals.data(),
                                          jacobians.data())) {
       continue;
+    }
+    // Under a robust loss, its weight rho'(s) there (reweighted least
+    // squares): Ceres's own correction (Triggs et al.) can leave a large
+    // gradient on a vanishing curvature, a quadratic whose minimum lies
+    // far away once the loss has saturated.
+    if (const ceres::LossFunction* loss =
+            problem_->GetLossFunctionForResidualBlock(id)) {
+      double rho[3];
+      loss->Evaluate(2.0 * value, rho);
+      value = 0.5 * rho[0];
+      const double root = std::sqrt(rho[1]);
+      for (double& r : residuals) r *= root;
+      for (std::size_t j = 0; j < blocks.size(); ++j) {
+        for (double& v : jacobian_rows[j]) v *= root;
+      }
     }
     const std::pair<bool, LandmarkId> key(source->second.has_landmark,
                                           source->second.landmark);

@@ -253,9 +253,11 @@ class SlamProblem {
   // Fixed-lag smoothing: every data residual whose timed trajectory blocks
   // are all constant, and which still moves another block (its landmark, a
   // calibration, the mean's rotation), leaves the problem for a FoldedPrior
-  // cost on those blocks, linearised where they are now. Returns how many it
-  // folded; a problem with folded residuals is no longer the data's whole
-  // problem (whoever folds builds that again for covariances and reports).
+  // cost on those blocks, linearised where they are now (a robust loss's
+  // weight rho' taken there). Residuals of a landmark without a prior stay.
+  // Returns how many it folded; a problem with folded residuals is no longer
+  // the data's whole problem (whoever folds builds that again for covariances
+  // and reports).
   int FoldFrozenResiduals();
   int num_folded() const { return num_folded_; }
 
