@@ -657,9 +657,8 @@ int SlamProblem::FoldFrozenResiduals() {
       continue;
     }
     // Under a robust loss, its weight rho'(s) there (reweighted least
-    // squares): Ceres's own correction (Triggs et al.) can leave a large
-    // gradient on a vanishing curvature, a quadratic whose minimum lies
-    // far away once the loss has saturated.
+    // squares): Ceres's correction where rho'' <= 0 (Cauchy's, Huber's), a
+    // positive curvature wherever the gradient is.
     if (const ceres::LossFunction* loss =
             problem_->GetLossFunctionForResidualBlock(id)) {
       double rho[3];
