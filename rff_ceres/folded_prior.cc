@@ -8,8 +8,8 @@
 namespace rff {
 
 void FoldedPrior::Add(const std::vector<double*>& blocks,
-                      const std::vector<int>& sizes,
-                      const std::vector<const double*>& jacobians,
+                      const std::vector<int32_t>& sizes,
+                      const std::vector<double*>& jacobians,
                       const double* residual, int rows, double cost) {
   // New blocks join the quadratic at their current values.
   for (std::size_t j = 0; j < blocks.size(); ++j) {

@@ -11,6 +11,7 @@
 #ifndef RFF_CERES_FOLDED_PRIOR_H_
 #define RFF_CERES_FOLDED_PRIOR_H_
 
+#include <cstdint>
 #include <map>
 #include <memory>
 #include <vector>
@@ -25,8 +26,9 @@ class FoldedPrior {
   // One residual of `rows` entries `residual` and cost `cost`, over
   // `blocks` of `sizes`; `jacobians[j]` row-major (rows x sizes[j]), or
   // nullptr for a block held constant (not part of the quadratic).
-  void Add(const std::vector<double*>& blocks, const std::vector<int>& sizes,
-           const std::vector<const double*>& jacobians, const double* residual,
+  void Add(const std::vector<double*>& blocks,
+           const std::vector<int32_t>& sizes,
+           const std::vector<double*>& jacobians, const double* residual,
            int rows, double cost);
 
   bool empty() const { return blocks_.empty(); }

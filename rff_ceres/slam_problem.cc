@@ -4,7 +4,6 @@
 #include <cmath>
 #include <cstring>
 #include <string_view>
-#include <unordered_set>
 
 #include "Eigen/Eigenvalues"
 #include "costs/calibrated_odometry_cost.h"
@@ -473,36 +472,43 @@ SlamProblem::ObservationResidualSeries() {
   return series;
 }
 
+bool SlamProblem::EvaluateVariableBlocks(ceres::ResidualBlockId id,
+                                         bool apply_loss,
+                                         BlockEvaluation* evaluation) {
+  BlockEvaluation& e = *evaluation;
+  const ceres::CostFunction* cost =
+      problem_->GetCostFunctionForResidualBlock(id);
+  const int rows = cost->num_residuals();
+  e.sizes = cost->parameter_block_sizes();
+  problem_->GetParameterBlocksForResidualBlock(id, &e.blocks);
+  e.residuals.assign(rows, 0.0);
+  e.jacobian_rows.resize(e.blocks.size());
+  e.jacobians.assign(e.blocks.size(), nullptr);
+  for (std::size_t j = 0; j < e.blocks.size(); ++j) {
+    if (problem_->IsParameterBlockConstant(e.blocks[j])) continue;
+    e.jacobian_rows[j].assign(static_cast<std::size_t>(rows) * e.sizes[j], 0.0);
+    e.jacobians[j] = e.jacobian_rows[j].data();
+  }
+  e.cost = 0.0;
+  return problem_->EvaluateResidualBlock(
+      id, apply_loss, &e.cost, e.residuals.data(), e.jacobians.data());
+}
+
 bool SlamProblem::FindNonFinite(std::string* description) {
   std::vector<ceres::ResidualBlockId> ids;
   problem_->GetResidualBlocks(&ids);
-  std::vector<double> residuals;
-  std::vector<std::vector<double>> jacobians;
-  std::vector<double*> jacobian_pointers;
-  std::vector<double*> blocks;
+  BlockEvaluation e;
   for (const ceres::ResidualBlockId id : ids) {
-    const ceres::CostFunction* cost =
-        problem_->GetCostFunctionForResidualBlock(id);
-    const std::vector<int32_t>& sizes = cost->parameter_block_sizes();
-    residuals.assign(cost->num_residuals(), 0.0);
-    jacobians.resize(sizes.size());
-    jacobian_pointers.resize(sizes.size());
-    problem_->GetParameterBlocksForResidualBlock(id, &blocks);
-    for (std::size_t i = 0; i < sizes.size(); ++i) {
-      // Ceres refuses a Jacobian of a constant block (frozen ones, in the
-      // incremental mode): that refusal is no non-finite value.
-      const bool constant = problem_->IsParameterBlockConstant(blocks[i]);
-      jacobians[i].assign(constant ? 0 : cost->num_residuals() * sizes[i], 0.0);
-      jacobian_pointers[i] = constant ? nullptr : jacobians[i].data();
-    }
-    double cost_value = 0.0;
-    const bool ok = problem_->EvaluateResidualBlock(
-        id, /*apply_loss_function=*/true, &cost_value, residuals.data(),
-        jacobian_pointers.data());
-    bool finite = ok && std::isfinite(cost_value);
-    for (const double r : residuals) finite = finite && std::isfinite(r);
-    for (const std::vector<double>& j : jacobians) {
-      for (const double v : j) finite = finite && std::isfinite(v);
+    // A constant (frozen) block's Jacobian is not asked for: Ceres's
+    // refusal would be no non-finite value.
+    bool finite = EvaluateVariableBlocks(id, /*apply_loss=*/true, &e) &&
+                  std::isfinite(e.cost);
+    for (const double r : e.residuals) finite = finite && std::isfinite(r);
+    for (std::size_t j = 0; j < e.blocks.size(); ++j) {
+      if (e.jacobians[j] == nullptr) continue;
+      for (const double v : e.jacobian_rows[j]) {
+        finite = finite && std::isfinite(v);
+      }
     }
     if (!finite) {
       *description = Describe(id) + " is not finite";
@@ -597,21 +603,20 @@ std::vector<VarianceGroup> SlamProblem::RowGroups(
 }
 
 int SlamProblem::FoldFrozenResiduals() {
-  // Timed blocks: a shared one (a rotation of the mean) moves every pose.
-  std::unordered_set<const double*> trajectory;
-  for (int b = 0; b < model_->num_blocks(); ++b) {
-    if (!model_->IsSharedBlock(b)) trajectory.insert(model_->mutable_block(b));
+  if (timed_blocks_.empty()) {
+    for (int b = 0; b < model_->num_blocks(); ++b) {
+      if (!model_->IsSharedBlock(b)) {
+        timed_blocks_.insert(model_->mutable_block(b));
+      }
+    }
   }
   // In the problem's (insertion) order: the sums are reproducible.
   std::vector<ceres::ResidualBlockId> ids;
   problem_->GetResidualBlocks(&ids);
   std::vector<double*> blocks;
-  std::vector<int> sizes;
-  std::vector<std::vector<double>> jacobian_rows;
-  std::vector<double*> jacobians;
-  std::vector<const double*> folded_jacobians;
-  std::vector<double> residuals;
+  BlockEvaluation e;
   std::set<std::pair<bool, LandmarkId>> changed;
+  const int before = num_folded_;
   for (const ceres::ResidualBlockId id : ids) {
     const auto source = sources_.find(id);
     // Timed data only: priors on landmarks and calibrations stay exact.
@@ -620,7 +625,7 @@ int SlamProblem::FoldFrozenResiduals() {
     bool timed = false, frozen = true, moves = false;
     for (double* block : blocks) {
       const bool constant = problem_->IsParameterBlockConstant(block);
-      if (trajectory.count(block) > 0) {
+      if (timed_blocks_.count(block) > 0) {
         timed = true;
         frozen = frozen && constant;
       } else {
@@ -635,46 +640,29 @@ int SlamProblem::FoldFrozenResiduals() {
         !has_landmark_prior(source->second.landmark)) {
       continue;
     }
-    const ceres::CostFunction* cost =
-        problem_->GetCostFunctionForResidualBlock(id);
-    const int rows = cost->num_residuals();
-    sizes = cost->parameter_block_sizes();
-    jacobian_rows.resize(blocks.size());
-    jacobians.assign(blocks.size(), nullptr);
-    folded_jacobians.assign(blocks.size(), nullptr);
-    for (std::size_t j = 0; j < blocks.size(); ++j) {
-      if (problem_->IsParameterBlockConstant(blocks[j])) continue;
-      jacobian_rows[j].resize(static_cast<std::size_t>(rows) * sizes[j]);
-      jacobians[j] = jacobian_rows[j].data();
-      folded_jacobians[j] = jacobians[j];
-    }
-    residuals.resize(rows);
-    double value = 0.0;
     // Left as it is where Ceres cannot evaluate it (the solve reports it).
-    if (!problem_->EvaluateResidualBlock(id, /*apply_loss_function=*/false,
-                                         &value, residuals.data(),
-                                         jacobians.data())) {
-      continue;
-    }
+    if (!EvaluateVariableBlocks(id, /*apply_loss=*/false, &e)) continue;
     // Under a robust loss, its weight rho'(s) there (reweighted least
     // squares): Ceres's correction where rho'' <= 0 (Cauchy's, Huber's), a
     // positive curvature wherever the gradient is.
     if (const ceres::LossFunction* loss =
             problem_->GetLossFunctionForResidualBlock(id)) {
       double rho[3];
-      loss->Evaluate(2.0 * value, rho);
-      value = 0.5 * rho[0];
+      loss->Evaluate(2.0 * e.cost, rho);
+      e.cost = 0.5 * rho[0];
       const double root = std::sqrt(rho[1]);
-      for (double& r : residuals) r *= root;
-      for (std::size_t j = 0; j < blocks.size(); ++j) {
-        for (double& v : jacobian_rows[j]) v *= root;
+      for (double& r : e.residuals) r *= root;
+      for (std::size_t j = 0; j < e.blocks.size(); ++j) {
+        if (e.jacobians[j] == nullptr) continue;
+        for (double& v : e.jacobian_rows[j]) v *= root;
       }
     }
     const std::pair<bool, LandmarkId> key(source->second.has_landmark,
                                           source->second.landmark);
-    folded_[key].prior.Add(blocks, sizes, folded_jacobians, residuals.data(),
-                           rows, value);
+    folded_[key].prior.Add(e.blocks, e.sizes, e.jacobians, e.residuals.data(),
+                           static_cast<int>(e.residuals.size()), e.cost);
     changed.insert(key);
+    ++num_folded_;
     if (source->second.has_landmark) {
       std::vector<ceres::ResidualBlockId>& of_landmark =
           landmark_residuals_[source->second.landmark];
@@ -694,9 +682,6 @@ int SlamProblem::FoldFrozenResiduals() {
                                          f.prior.blocks());
     Remember(f.block, {"folded past", 0.0, 0.0, 0, false, /*has_time=*/false});
   }
-  const int before = num_folded_;
-  num_folded_ = 0;
-  for (const auto& [key, f] : folded_) num_folded_ += f.prior.num_folded();
   // Costs were deleted: none can follow new scales, and the layouts and a
   // kept linearisation describe residuals that are gone.
   observation_weights_.clear();

@@ -12,6 +12,7 @@
 #include <string>
 #include <string_view>
 #include <unordered_map>
+#include <unordered_set>
 #include <utility>
 #include <vector>
 
@@ -321,6 +322,19 @@ class SlamProblem {
     }
   };
   std::string Describe(ceres::ResidualBlockId id) const;
+  // One residual block at the current values: its cost, residuals and the
+  // row-major Jacobian of each block not held constant (nullptr for those,
+  // whose Jacobian Ceres refuses). Buffers keep their capacity across calls.
+  struct BlockEvaluation {
+    std::vector<double*> blocks;
+    std::vector<int32_t> sizes;
+    double cost = 0.0;
+    std::vector<double> residuals;
+    std::vector<std::vector<double>> jacobian_rows;
+    std::vector<double*> jacobians;
+  };
+  bool EvaluateVariableBlocks(ceres::ResidualBlockId id, bool apply_loss,
+                              BlockEvaluation* evaluation);
   // The block's whitened residuals without its robust loss; false where
   // Ceres cannot evaluate it (a non-finite residual).
   bool EvaluateWithoutLoss(ceres::ResidualBlockId id,
@@ -392,6 +406,9 @@ class SlamProblem {
   };
   std::map<std::pair<bool, LandmarkId>, Folded> folded_;
   int num_folded_ = 0;
+  // The model's timed blocks (not a shared one, such as the mean's
+  // rotation, which moves every pose), filled by the first fold.
+  std::unordered_set<const double*> timed_blocks_;
 };
 
 }  // namespace rff

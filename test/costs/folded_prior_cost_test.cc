@@ -89,7 +89,7 @@ TEST(FoldedPriorTest, LinearResidualsFoldExactly) {
   auto fold = [&](const Residual& r) {
     std::vector<double*> blocks;
     std::vector<int> block_sizes;
-    std::vector<const double*> jacobians;
+    std::vector<double*> jacobians;
     std::vector<
         Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>
         rows;
