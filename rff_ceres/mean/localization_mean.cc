@@ -132,16 +132,6 @@ namespace {
 // the heading held): far beyond a turn, so the smoother ignores it.
 constexpr double kUnmeasuredHeadingVariance = 1e6;
 
-// The sum of squared whitened residuals of `observations` at `p`.
-double Cost(const std::vector<MapObservation>& observations,
-            const Eigen::Vector3d& p) {
-  std::vector<MapResidualRow> rows;
-  AppendMapResiduals(observations, p, &rows);
-  double cost = 0.0;
-  for (const MapResidualRow& r : rows) cost += r.residual * r.residual;
-  return cost;
-}
-
 // One pose against the map as a ceres::TinySolver function of its free
 // unknowns: x, y, and theta unless `kFree` is 2 (the heading held at the
 // start's). MapResiduals keeps one row per measured value at every pose.
@@ -197,32 +187,95 @@ class PoseFit {
 // basin; the cap only ends a degenerate geometry's slow crawl.
 constexpr int kMaxRefineIterations = 50;
 
+// A minimum a start reached, and the Gauss-Newton information of the fit's
+// free unknowns there (J^T J of its whitened rows).
+struct Minimum {
+  double cost = 0.0;
+  Eigen::Vector3d pose;
+  Eigen::Matrix3d information;
+};
+
+// A start is taken to end at a minimum already found once its iterate is
+// within this of it in the fit's whitened units, (x - m)^T I (x - m): its
+// cost then differs from the minimum's by about as much, where the selection
+// below tells minima apart by kAmbiguousChi2 = 4. Most turned starts end at
+// the prediction's minimum, and the last of their steps crawl (the
+// Gauss-Newton Hessian misses the curvature the landmarks' spread adds).
+constexpr double kSameMinimumChi2 = 1e-2;
+// Steps between the tests of a start against the minima found.
+constexpr int kStepsBetweenTests = 4;
+
+Minimum MinimumAt(const std::vector<MapObservation>& observations,
+                  const Eigen::Vector3d& pose) {
+  Minimum m;
+  m.pose = pose;
+  m.information.setZero();
+  std::vector<MapResidualRow> rows;
+  AppendMapResiduals(observations, pose, &rows);
+  for (const MapResidualRow& r : rows) {
+    m.cost += r.residual * r.residual;
+    m.information += r.jacobian.transpose() * r.jacobian;
+  }
+  return m;
+}
+
+// The first of `found` whose whitened distance from `pose` over the first
+// kFree unknowns is within kSameMinimumChi2, or -1.
 template <int kFree>
-void RefineFree(const std::vector<MapObservation>& observations,
-                Eigen::Vector3d* pose) {
+int SameMinimum(const std::vector<Minimum>& found,
+                const Eigen::Vector3d& pose) {
+  for (std::size_t i = 0; i < found.size(); ++i) {
+    Eigen::Vector3d d = pose - found[i].pose;
+    d.z() = WrapAngle(d.z());
+    const Eigen::Matrix<double, kFree, 1> free = d.head<kFree>();
+    const double chi2 =
+        free.dot(found[i].information.topLeftCorner<kFree, kFree>() * free);
+    if (chi2 <= kSameMinimumChi2) return static_cast<int>(i);
+  }
+  return -1;
+}
+
+// Refines `pose` over its first kFree unknowns; returns the index in `found`
+// of the minimum it was found to head for (leaving `pose` where the test
+// took it), or -1 where it converged (or stopped) on its own.
+template <int kFree>
+int RefineFree(const std::vector<MapObservation>& observations,
+               const std::vector<Minimum>& found, Eigen::Vector3d* pose) {
   const PoseFit<kFree> fit(observations, *pose);
-  ceres::TinySolver<PoseFit<kFree>> solver;
-  solver.options.max_num_iterations = kMaxRefineIterations;
+  using Solver = ceres::TinySolver<PoseFit<kFree>>;
+  Solver solver;
   // Costs are chi-square sums of order the rows: stop at changes and steps
   // far below any that matters to a fix.
-  solver.options.function_tolerance = 1e-12;
-  solver.options.parameter_tolerance = 1e-12;
+  solver.options.function_tolerance = 1e-9;
+  solver.options.parameter_tolerance = 1e-10;
   Eigen::Matrix<double, kFree, 1> x = pose->head<kFree>();
-  solver.Solve(fit, &x);
-  if (x.allFinite()) *pose = fit.Pose(x.data());
+  if (found.empty()) {
+    solver.options.max_num_iterations = kMaxRefineIterations;
+    solver.Solve(fit, &x);
+    if (x.allFinite()) *pose = fit.Pose(x.data());
+    return -1;
+  }
+  // In runs of kStepsBetweenTests steps (TinySolver's iterations count from
+  // 1), each run from the last one's point.
+  solver.options.max_num_iterations = kStepsBetweenTests + 1;
+  for (int steps = 0; steps < kMaxRefineIterations;
+       steps += kStepsBetweenTests) {
+    const typename Solver::Summary& summary = solver.Solve(fit, &x);
+    if (!x.allFinite()) return -1;
+    *pose = fit.Pose(x.data());
+    if (summary.status != Solver::HIT_MAX_ITERATIONS) return -1;
+    const int same = SameMinimum<kFree>(found, *pose);
+    if (same >= 0) return same;
+  }
+  return -1;
 }
 
 // Levenberg-Marquardt (ceres::TinySolver) from `pose` over the free unknowns
-// (`free_heading` false holds theta). Returns the final cost (the sum of
-// squared whitened residuals) and leaves the pose in `pose`.
-double Refine(const std::vector<MapObservation>& observations,
-              bool free_heading, Eigen::Vector3d* pose) {
-  if (free_heading) {
-    RefineFree<3>(observations, pose);
-  } else {
-    RefineFree<2>(observations, pose);
-  }
-  return Cost(observations, *pose);
+// (`free_heading` false holds theta), leaving the pose in `pose`: RefineFree.
+int Refine(const std::vector<MapObservation>& observations, bool free_heading,
+           const std::vector<Minimum>& found, Eigen::Vector3d* pose) {
+  return free_heading ? RefineFree<3>(observations, found, pose)
+                      : RefineFree<2>(observations, found, pose);
 }
 
 // LocalizePose on the observations whose landmarks are found: looked up
@@ -242,28 +295,31 @@ bool LocalizeAgainst(const std::vector<MapObservation>& usable,
   // minima within kAmbiguousChi2 of the best take the one nearest the first
   // seed (the prediction).
   constexpr double kAmbiguousChi2 = 4.0;
-  std::vector<std::pair<double, Eigen::Vector3d>> minima;
+  std::vector<Minimum> minima;
   double lowest = std::numeric_limits<double>::infinity();
   for (Eigen::Vector3d pose : seeds) {
     if (fixed_heading != nullptr) pose.z() = *fixed_heading;
-    const double cost = Refine(usable, free_heading, &pose);
-    if (!std::isfinite(cost) || !pose.allFinite()) continue;
-    minima.emplace_back(cost, pose);
-    lowest = std::min(lowest, cost);
+    // A start heading for a minimum already found adds nothing.
+    if (Refine(usable, free_heading, minima, &pose) >= 0) continue;
+    Minimum minimum = MinimumAt(usable, pose);
+    if (!std::isfinite(minimum.cost) || !pose.allFinite()) continue;
+    lowest = std::min(lowest, minimum.cost);
+    minima.push_back(minimum);
   }
   if (minima.empty()) return false;
   double best_cost = 0.0, nearest = std::numeric_limits<double>::infinity();
   Eigen::Vector3d best = seeds.front();
-  for (const auto& [cost, pose] : minima) {
-    if (cost > lowest + kAmbiguousChi2) continue;
+  for (const Minimum& m : minima) {
+    if (m.cost > lowest + kAmbiguousChi2) continue;
     // Metres, and a radian of heading counted as a metre.
     const double distance =
-        (pose.head<2>() - seeds.front().head<2>()).norm() +
-        (free_heading ? std::abs(WrapAngle(pose.z() - seeds.front().z())) : 0);
+        (m.pose.head<2>() - seeds.front().head<2>()).norm() +
+        (free_heading ? std::abs(WrapAngle(m.pose.z() - seeds.front().z()))
+                      : 0);
     if (distance < nearest) {
       nearest = distance;
-      best_cost = cost;
-      best = pose;
+      best_cost = m.cost;
+      best = m.pose;
     }
   }
 

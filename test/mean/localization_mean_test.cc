@@ -224,6 +224,59 @@ TEST(LocalizePoseTest, FixIsAStationaryPointOfItsCost) {
   }
 }
 
+// Starts that head for the prediction's minimum are cut short (the fit's
+// whitened distance to it under kSameMinimumChi2): sixteen starts turned
+// around the circle give the fix of the prediction alone.
+TEST(LocalizePoseTest, TurnedStartsGiveThePredictionsFix) {
+  const WideMapScene scene = MakeWideMapScene();
+  const Eigen::Vector3d prediction(2.0, -1.0, 0.1);
+  std::vector<Eigen::Vector3d> seeds = {prediction};
+  for (int k = 1; k < 16; ++k) {
+    seeds.push_back(prediction + Eigen::Vector3d(0.0, 0.0, k * M_PI / 8.0));
+  }
+  PoseFix alone, turned;
+  ASSERT_TRUE(LocalizePose(scene.observations, scene.landmarks, {prediction},
+                           nullptr, 0.1, &alone));
+  ASSERT_TRUE(LocalizePose(scene.observations, scene.landmarks, seeds, nullptr,
+                           0.1, &turned));
+  EXPECT_EQ(turned.pose.x, alone.pose.x);
+  EXPECT_EQ(turned.pose.y, alone.pose.y);
+  EXPECT_EQ(turned.pose.theta, alone.pose.theta);
+  EXPECT_EQ(turned.chi2, alone.chi2);
+}
+
+// Ranges of two landmarks fit a pose and its mirror image; a third, 0.5 m
+// off their line, tells them apart. From a prediction beside the mirror the
+// second start still reaches the true pose: a minimum found is no basin for
+// a start that does not come within the fit's noise of it.
+TEST(LocalizePoseTest, AStartInAnotherBasinFindsTheBetterMinimum) {
+  const std::map<LandmarkId, KnownLandmark> landmarks = {
+      {0, {Eigen::Vector2d(0.0, 0.0), 0.0}},
+      {1, {Eigen::Vector2d(10.0, 0.0), 0.0}},
+      {2, {Eigen::Vector2d(5.0, 0.5), 0.0}}};
+  const Eigen::Vector2d robot(5.0, 6.0);
+  std::vector<Observation> observations;
+  for (const auto& [id, landmark] : landmarks) {
+    Observation o;
+    o.type = ObservationType::kRange;
+    o.id = id;
+    o.range = (landmark.position - robot).norm();
+    o.sigma_range = 0.1;
+    observations.push_back(o);
+  }
+  const std::vector<Eigen::Vector3d> seeds = {Eigen::Vector3d(5.2, -5.8, 0.0),
+                                              Eigen::Vector3d(-3.0, 25.0, 0.0)};
+  PoseFix mirror, fix;
+  ASSERT_TRUE(LocalizePose(observations, landmarks, {seeds.front()}, nullptr,
+                           0.1, &mirror));
+  EXPECT_LT(mirror.pose.y, 0.0);
+  EXPECT_GT(mirror.chi2, 4.0);
+  ASSERT_TRUE(LocalizePose(observations, landmarks, seeds, nullptr, 0.1, &fix));
+  EXPECT_NEAR(fix.pose.x, robot.x(), 1e-6);
+  EXPECT_NEAR(fix.pose.y, robot.y(), 1e-6);
+  EXPECT_NEAR(fix.chi2, 0.0, 1e-9);
+}
+
 TEST(LocalizationMeanTest, NoLocalisableTimeIsAClearError) {
   // Range-only with one landmark in view per step: never enough ranges.
   SimulationOptions sim = PaperOptions(3);
