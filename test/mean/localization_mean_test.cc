@@ -246,9 +246,9 @@ TEST(LocalizePoseTest, TurnedStartsGiveThePredictionsFix) {
 }
 
 // Ranges of two landmarks fit a pose and its mirror image; a third, 0.5 m
-// off their line, tells them apart. From a prediction beside the mirror the
-// second start still reaches the true pose: a minimum found is no basin for
-// a start that does not come within the fit's noise of it.
+// off their line, tells them apart. From a prediction beside the mirror a
+// second start 20 m away still reaches the true pose: a minimum found takes
+// no start that does not come within the fit's noise of it.
 TEST(LocalizePoseTest, AStartInAnotherBasinFindsTheBetterMinimum) {
   const std::map<LandmarkId, KnownLandmark> landmarks = {
       {0, {Eigen::Vector2d(0.0, 0.0), 0.0}},
