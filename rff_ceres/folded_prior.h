@@ -31,7 +31,6 @@ class FoldedPrior {
            const std::vector<double*>& jacobians, const double* residual,
            int rows, double cost);
 
-  bool empty() const { return blocks_.empty(); }
   int num_folded() const { return num_folded_; }
   // The blocks of the quadratic, in the order MakeCost's cost takes them.
   const std::vector<double*>& blocks() const { return blocks_; }

@@ -616,7 +616,7 @@ int SlamProblem::FoldFrozenResiduals() {
   std::vector<double*> blocks;
   BlockEvaluation e;
   std::set<std::pair<bool, LandmarkId>> changed;
-  const int before = num_folded_;
+  int folded = 0;
   for (const ceres::ResidualBlockId id : ids) {
     const auto source = sources_.find(id);
     // Timed data only: priors on landmarks and calibrations stay exact.
@@ -662,7 +662,7 @@ int SlamProblem::FoldFrozenResiduals() {
     folded_[key].prior.Add(e.blocks, e.sizes, e.jacobians, e.residuals.data(),
                            static_cast<int>(e.residuals.size()), e.cost);
     changed.insert(key);
-    ++num_folded_;
+    ++folded;
     if (source->second.has_landmark) {
       std::vector<ceres::ResidualBlockId>& of_landmark =
           landmark_residuals_[source->second.landmark];
@@ -689,7 +689,13 @@ int SlamProblem::FoldFrozenResiduals() {
   weighted_ = false;
   layout_.reset();
   DropLinearization();
-  return num_folded_ - before;
+  return folded;
+}
+
+int SlamProblem::num_folded() const {
+  int folded = 0;
+  for (const auto& [key, f] : folded_) folded += f.prior.num_folded();
+  return folded;
 }
 
 std::shared_ptr<ceres::ParameterBlockOrdering> SlamProblem::Ordering() {

@@ -260,7 +260,7 @@ class SlamProblem {
   // the data's whole problem (whoever folds builds that again for covariances
   // and reports).
   int FoldFrozenResiduals();
-  int num_folded() const { return num_folded_; }
+  int num_folded() const;  // In all, over the priors.
 
   // Landmarks in group 0 (eliminated first), trajectory blocks in group 1,
   // the model's shared blocks (a rotation of its mean) in group 2, the range
@@ -405,7 +405,6 @@ class SlamProblem {
     ceres::ResidualBlockId block = nullptr;
   };
   std::map<std::pair<bool, LandmarkId>, Folded> folded_;
-  int num_folded_ = 0;
   // The model's timed blocks (not a shared one, such as the mean's
   // rotation, which moves every pose), filled by the first fold.
   std::unordered_set<const double*> timed_blocks_;

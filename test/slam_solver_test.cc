@@ -64,6 +64,17 @@ SlamOptions WnoaWithoutLearning() {
   return options;
 }
 
+// Every landmark at its prior's position, moved by `offset`.
+std::map<LandmarkId, Eigen::Vector2d> LandmarksAtPriors(
+    const Dataset& dataset,
+    const Eigen::Vector2d& offset = Eigen::Vector2d::Zero()) {
+  std::map<LandmarkId, Eigen::Vector2d> landmarks;
+  for (const LandmarkPrior& prior : dataset.landmark_priors) {
+    landmarks[prior.id] = Eigen::Vector2d(prior.x, prior.y) + offset;
+  }
+  return landmarks;
+}
+
 // The envelope of the problem RunSlam builds first for `dataset`.
 void EnvelopeSizeOf(const Dataset& dataset, const SlamOptions& options,
                     BandedSize* size) {
@@ -74,10 +85,8 @@ void EnvelopeSizeOf(const Dataset& dataset, const SlamOptions& options,
   std::unique_ptr<TrajectoryModel> model =
       CreateTrajectoryModel(dataset, options, mean, &error);
   ASSERT_NE(model, nullptr) << error;
-  std::map<LandmarkId, Eigen::Vector2d> landmarks;
-  for (const LandmarkPrior& prior : dataset.landmark_priors) {
-    landmarks[prior.id] = Eigen::Vector2d(prior.x, prior.y);
-  }
+  const std::map<LandmarkId, Eigen::Vector2d> landmarks =
+      LandmarksAtPriors(dataset);
   SlamProblem problem(model.get(), options.problem);
   ASSERT_TRUE(problem.Build(dataset, landmarks, &error)) << error;
   *size = BandedProblem(*problem.problem(), problem.BandColumns()).Size();
@@ -346,11 +355,8 @@ TEST(SlamProblemTest, FollowingScalesGivesTheProblemABuildGives) {
   const std::shared_ptr<const MeanFunction> mean =
       BuildPriorMean("constant", dataset, &error);
   ASSERT_NE(mean, nullptr) << error;
-  std::map<LandmarkId, Eigen::Vector2d> landmarks;
-  for (const LandmarkPrior& prior : dataset.landmark_priors) {
-    landmarks[prior.id] =
-        Eigen::Vector2d(prior.x, prior.y) + Eigen::Vector2d(0.3, -0.2);
-  }
+  const std::map<LandmarkId, Eigen::Vector2d> landmarks =
+      LandmarksAtPriors(dataset, Eigen::Vector2d(0.3, -0.2));
   auto model = CreateTrajectoryModel(dataset, options, mean, &error);
   ASSERT_NE(model, nullptr) << error;
   std::mt19937 rng(4);
@@ -1247,10 +1253,8 @@ TEST(SlamProblemTest, FrozenBlocksAreNotTakenForNonFiniteResiduals) {
   const std::shared_ptr<const MeanFunction> mean =
       BuildPriorMean("constant", dataset, &error);
   ASSERT_NE(mean, nullptr) << error;
-  std::map<LandmarkId, Eigen::Vector2d> landmarks;
-  for (const LandmarkPrior& prior : dataset.landmark_priors) {
-    landmarks[prior.id] = Eigen::Vector2d(prior.x, prior.y);
-  }
+  const std::map<LandmarkId, Eigen::Vector2d> landmarks =
+      LandmarksAtPriors(dataset);
   auto model = CreateTrajectoryModel(dataset, options, mean, &error);
   ASSERT_NE(model, nullptr) << error;
   auto frozen_problem = [&](const Dataset& data) {

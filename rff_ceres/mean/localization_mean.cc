@@ -187,8 +187,8 @@ class PoseFit {
 // basin; the cap only ends a degenerate geometry's slow crawl.
 constexpr int kMaxRefineIterations = 50;
 
-// A minimum a start reached, and the Gauss-Newton information of the fit's
-// free unknowns there (J^T J of its whitened rows).
+// A minimum a start reached, and the Gauss-Newton information of the pose
+// there (J^T J of its whitened rows; a held heading's row and column unused).
 struct Minimum {
   double cost = 0.0;
   Eigen::Vector3d pose;
