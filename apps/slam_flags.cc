@@ -5,8 +5,9 @@
 // Trajectory prior.
 DEFINE_string(prior, "rff",
               "Trajectory prior: rff (weight-space GP features, the paper's "
-              "method) or wnoa (LTV-SDE white-noise-on-acceleration states, "
-              "the gpslam baseline).");
+              "method), wnoa (LTV-SDE white-noise-on-acceleration states, "
+              "the gpslam baseline) or wnoj (white-noise-on-jerk states, "
+              "STEAM's constant-acceleration prior).");
 DEFINE_string(prior_mean, "auto",
               "Prior mean: auto, odometry, wnoa, localization, spline or "
               "constant. auto: with ODOM records in batch mode, wnoa for the "
@@ -94,20 +95,41 @@ DEFINE_double(
     wnoa_heading_qc, 0.1,
     "WNOA: Q_c of the heading acceleration (rad^2/s^3), more than 0.");
 DEFINE_double(wnoa_initial_position_sigma, 10.0,
-              "WNOA: prior sigma of the first state's position deviation (m), "
+              "WNOA and WNOJ: prior sigma of the first state's position "
+              "deviation (m), "
               "more than 0.");
 DEFINE_double(wnoa_initial_heading_sigma, 1.0,
-              "WNOA: prior sigma of the first state's heading deviation (rad), "
+              "WNOA and WNOJ: prior sigma of the first state's heading "
+              "deviation (rad), "
               "more than 0.");
 DEFINE_double(wnoa_initial_velocity_sigma, 1.0,
-              "WNOA: prior sigma of the first state's velocity (m/s), more "
+              "WNOA and WNOJ: prior sigma of the first state's velocity "
+              "(m/s), more "
               "than 0.");
 DEFINE_double(wnoa_initial_angular_velocity_sigma, 1.0,
-              "WNOA: prior sigma of the first state's angular velocity "
+              "WNOA and WNOJ: prior sigma of the first state's angular "
+              "velocity "
               "(rad/s), more than 0.");
 DEFINE_double(wnoa_min_state_spacing, 0.0,
               "WNOA: merge states closer than this (seconds), 0 or more; 0 "
               "keeps one per observation time.");
+
+// WNOJ (white-noise-on-jerk) prior.
+DEFINE_double(wnoj_position_qc, 1.0,
+              "WNOJ: power spectral density Q_c of the x and y jerk "
+              "(m^2/s^5), more than 0.");
+DEFINE_double(wnoj_heading_qc, 0.1,
+              "WNOJ: Q_c of the heading jerk (rad^2/s^5), more than 0.");
+DEFINE_double(wnoj_initial_acceleration_sigma, 1.0,
+              "WNOJ: prior sigma of the first state's acceleration (m/s^2), "
+              "more than 0.");
+DEFINE_double(wnoj_initial_angular_acceleration_sigma, 1.0,
+              "WNOJ: prior sigma of the first state's angular acceleration "
+              "(rad/s^2), more than 0.");
+DEFINE_double(wnoj_min_state_spacing, 0.01,
+              "WNOJ: merge states closer than this (seconds), 0 or more. Its "
+              "prior's information grows as dt^-5: states milliseconds apart "
+              "make the system unfactorisable in double precision.");
 
 // Incremental mode.
 DEFINE_int32(incremental_every, 0,
@@ -214,7 +236,8 @@ namespace {
 bool KernelHyperparametersGiven() {
   for (const char* flag :
        {"lengthscale", "kernel_variance", "heading_lengthscale",
-        "heading_kernel_variance", "wnoa_position_qc", "wnoa_heading_qc"}) {
+        "heading_kernel_variance", "wnoa_position_qc", "wnoa_heading_qc",
+        "wnoj_position_qc", "wnoj_heading_qc"}) {
     if (!gflags::GetCommandLineFlagInfoOrDie(flag).is_default) return true;
   }
   return false;
@@ -240,6 +263,13 @@ SlamOptions SlamOptionsFromFlags() {
   w.initial_velocity_sigma = FLAGS_wnoa_initial_velocity_sigma;
   w.initial_angular_velocity_sigma = FLAGS_wnoa_initial_angular_velocity_sigma;
   w.min_state_spacing = FLAGS_wnoa_min_state_spacing;
+  WnojOptions& j = options.wnoj;
+  j.position_qc = FLAGS_wnoj_position_qc;
+  j.heading_qc = FLAGS_wnoj_heading_qc;
+  j.initial_acceleration_sigma = FLAGS_wnoj_initial_acceleration_sigma;
+  j.initial_angular_acceleration_sigma =
+      FLAGS_wnoj_initial_angular_acceleration_sigma;
+  j.min_state_spacing = FLAGS_wnoj_min_state_spacing;
   options.incremental.every = FLAGS_incremental_every;
   options.incremental.lag = FLAGS_incremental_lag;
   options.mean.outer_rounds = FLAGS_outer_rounds;

@@ -18,6 +18,7 @@
 #include "rff_ceres/slam_problem.h"
 #include "rff_ceres/types.h"
 #include "rff_ceres/wnoa_trajectory.h"
+#include "rff_ceres/wnoj_trajectory.h"
 
 namespace rff {
 
@@ -79,7 +80,8 @@ struct OutputOptions {
 
 struct SlamOptions {
   // Trajectory prior, by its registry name (priors/trajectory_prior.h):
-  // "rff" (weight-space features) or "wnoa" (LTV-SDE states).
+  // "rff" (weight-space features), "wnoa" (LTV-SDE states, white noise on
+  // acceleration) or "wnoj" (white noise on jerk).
   std::string prior = "rff";
   MeanOptions mean;
   StartOptions start;
@@ -92,11 +94,14 @@ struct SlamOptions {
   // (hyperparameter_learning.h): "on", "off", or "auto", on for data without
   // odometry. With odometry the GP models the drift of dead reckoning, which
   // grows along the run: a stationary kernel learned on a window misjudges
-  // it (docs/prior_means.md, "RFF with odometry"). WNOA learns Q_c and the
-  // noise scales of the data unless "off".
+  // it (docs/prior_means.md, "RFF with odometry"). WNOA and WNOJ learn Q_c
+  // and the noise scales of the data unless "off".
   std::string learn_hyperparameters = "auto";
   LearningOptions learning;
+  // The Markov-state priors; the first state's position, heading and
+  // velocity sigmas in `wnoa` serve both.
   WnoaOptions wnoa;
+  WnojOptions wnoj;
   // The data's residuals: noise scales, losses, odometry, calibration.
   ProblemOptions problem;
   SolverOptions solver;

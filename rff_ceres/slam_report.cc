@@ -314,6 +314,10 @@ void WriteSummaryJson(const SlamOptions& options, const SlamResult& result,
       << FormatNumber(result.wnoa_options.position_qc) << ",\n"
       << "  \"wnoa_heading_qc\": "
       << FormatNumber(result.wnoa_options.heading_qc) << ",\n"
+      << "  \"wnoj_position_qc\": "
+      << FormatNumber(result.wnoj_options.position_qc) << ",\n"
+      << "  \"wnoj_heading_qc\": "
+      << FormatNumber(result.wnoj_options.heading_qc) << ",\n"
       << "  \"loss\": " << JsonString(options.problem.loss.name) << ",\n"
       << "  \"loss_scale\": " << FormatNumber(options.problem.loss.scale)
       << ",\n"

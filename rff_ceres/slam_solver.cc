@@ -218,6 +218,7 @@ bool ReportSolution(const Dataset& dataset, const SlamOptions& options,
   result->wnoa_options = wnoa_mean_solve.trajectory.empty()
                              ? settled->wnoa
                              : wnoa_mean_solve.wnoa_options;
+  result->wnoj_options = settled->wnoj;
   // And what that solve unwound on its way.
   result->heading_windings_unwound.insert(
       result->heading_windings_unwound.begin(),

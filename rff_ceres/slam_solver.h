@@ -60,9 +60,10 @@ struct SlamResult {
   std::vector<IncrementalUpdate> updates;  // Incremental mode only.
   StartHeading start_heading;
   // The models as solved: learned kernels and settled capacity (RFF),
-  // learned Q_c (WNOA).
+  // learned Q_c (WNOA, WNOJ).
   FeatureTrajectoryOptions trajectory_options;
   WnoaOptions wnoa_options;
+  WnojOptions wnoj_options;
   bool learned = false;
   LearningReport learning;
   // Rounds of variance-component rescaling of the prior's scales, and the

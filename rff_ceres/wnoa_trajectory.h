@@ -27,15 +27,14 @@
 #ifndef RFF_CERES_WNOA_TRAJECTORY_H_
 #define RFF_CERES_WNOA_TRAJECTORY_H_
 
-#include <array>
-#include <map>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "Eigen/Core"
 #include "rff_ceres/mean/mean_function.h"
-#include "rff_ceres/trajectory_model.h"
+#include "rff_ceres/state_trajectory.h"
 
 namespace rff {
 
@@ -55,7 +54,7 @@ struct WnoaOptions {
   double min_state_spacing = 0.0;
 };
 
-class WnoaTrajectory : public TrajectoryModel {
+class WnoaTrajectory : public StateTrajectory {
  public:
   static constexpr int kStateSize = 6;
 
@@ -66,44 +65,6 @@ class WnoaTrajectory : public TrajectoryModel {
       const WnoaOptions& options, std::shared_ptr<const MeanFunction> mean,
       std::vector<double> state_times, std::string* error);
 
-  int num_blocks() const override;
-  int block_size(int /*block*/) const override { return kStateSize; }
-  double* mutable_block(int block) override;
-  PoseMap PoseAt(double t) const override;
-  Eigen::Vector3d Pose(double t) const override;
-  // The interpolations of `previous` where its state times are these (Q_c
-  // cancels out of them).
-  void AdoptCaches(const TrajectoryModel& previous) override;
-  // Q_c of `rescaled` where its states and mean are these: the
-  // interpolations do not depend on it, the motion prior's costs do
-  // (UpdatePriorCosts).
-  bool AdoptScales(TrajectoryModel* rescaled) override;
-  void UpdatePriorCosts(
-      const std::vector<ceres::CostFunction*>& costs) const override;
-  // The initial-state prior on block 0 and one WnoaPriorCost between every
-  // pair of consecutive states (a pair belongs to its later state).
-  using TrajectoryModel::AddPriorCosts;
-  void AddPriorCosts(ceres::Problem* problem, int begin, int end) override;
-  const MeanFunction& mean() const override;
-  void set_mean(std::shared_ptr<const MeanFunction> mean) override;
-  // The motion prior's rows follow the state (position, position, heading,
-  // ...); the initial-state prior has a fixed scale.
-  std::vector<PriorScale> PriorRowScales(const std::vector<double*>& blocks,
-                                         int num_rows) const override;
-  bool PriorScalesWhitenRows() const override { return true; }
-
-  const std::vector<double>& state_times() const;
-
-  // Sets every state to follow `poses` (sorted by time, at least one):
-  // positions from their linear interpolation minus the mean, velocities the
-  // smoothest under the prior given those positions (one tridiagonal solve
-  // per coordinate).
-  void SetStatesFromPoses(const std::vector<TimedPose>& poses);
-  bool SetBlocksFromPoses(const std::vector<TimedPose>& poses) override {
-    SetStatesFromPoses(poses);
-    return true;
-  }
-
   // The per-coordinate 2x2 interpolation matrices at `elapsed` = tau - t_i
   // in an interval of length `dt` = t_{i+1} - t_i > 0, in closed form
   // (cubic Hermite basis in s = elapsed / dt; Q_c cancels out):
@@ -112,28 +73,31 @@ class WnoaTrajectory : public TrajectoryModel {
                                     Eigen::Matrix2d* lambda,
                                     Eigen::Matrix2d* psi);
 
- private:
-  WnoaTrajectory() = default;
+  // The velocities at `times` (sorted, distinct) that minimise the WNOA
+  // energy sum_k e_k^T Q_k^-1 e_k of one coordinate with its `positions`
+  // held (wnoa_prior_cost.h; q_c cancels). Central differences would
+  // disagree across states microseconds apart, where Q^-1 ~ dt^-3 turns
+  // that into a prior cost of 10^5 and a solve that leaves its start.
+  static std::vector<double> SmoothestVelocities(
+      const std::vector<double>& times, const std::vector<double>& positions);
 
-  // The blocks and per-coordinate phi vectors that give the pose at one time.
-  struct Interpolation {
-    int num_blocks = 0;  // 1 (at a state time or outside the span) or 2.
-    std::array<int, 2> blocks = {0, 0};
-    // phi[k][c]: coordinate c's 6-vector on blocks[k].
-    std::array<std::array<std::shared_ptr<const Eigen::VectorXd>, 3>, 2> phi;
-  };
-  const Interpolation& InterpolationAt(double t) const;
+ private:
+  WnoaTrajectory(const WnoaOptions& options,
+                 std::shared_ptr<const MeanFunction> mean,
+                 std::vector<double> times)
+      : StateTrajectory(2, std::move(mean), std::move(times)),
+        options_(options) {}
+  void PositionRows(double elapsed, double dt, double* lambda,
+                    double* psi) const override;
+  // SmoothestVelocities of the coordinate's positions.
+  void SetSmoothestDerivatives(int c) override;
+  // WnoaInitialStateCost and WnoaPriorCost.
+  ceres::CostFunction* NewInitialStateCost() const override;
+  ceres::CostFunction* NewMotionCost(double dt) const override;
+  void SetMotionQc(ceres::CostFunction* cost) const override;
+  bool TakeScales(const StateTrajectory& rescaled) override;
 
   WnoaOptions options_;
-  std::shared_ptr<const MeanFunction> mean_;
-  std::vector<double> times_;   // Sorted, thinned state times.
-  std::vector<double> states_;  // kStateSize values per state, contiguous.
-  // e_c, shared by the poses at every state time.
-  std::array<std::shared_ptr<const Eigen::VectorXd>, 3> unit_phi_;
-  // Observations at the same time share their phi vectors; so do the
-  // models of a learning's rounds (AdoptCaches).
-  std::shared_ptr<std::map<double, Interpolation>> cache_ =
-      std::make_shared<std::map<double, Interpolation>>();
 };
 
 }  // namespace rff

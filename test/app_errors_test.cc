@@ -188,8 +188,8 @@ const AppCase kAppCases[] = {
     // Options are checked before the dataset is read.
     {"SlamBadOptionBeforeMissingDataset",
      "{bin}/rff_slam --dataset={dir}/missing.rffd --prior=brownian" SLAM_OUT,
-     "rff_slam: error: --prior=brownian: unknown prior; allowed rff or "
-     "wnoa\n",
+     "rff_slam: error: --prior=brownian: unknown prior; allowed rff, wnoa "
+     "or wnoj\n",
      "{dir}/out.tum"},
     {"SlamNegativeOuterRounds", SLAM "--outer_rounds=-1" SLAM_OUT,
      "rff_slam: error: --outer_rounds=-1: allowed 0 to 100\n", "{dir}/out.tum"},

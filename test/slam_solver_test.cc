@@ -862,7 +862,7 @@ INSTANTIATE_TEST_SUITE_P(
                   [](SlamOptions* o) { o->mean.spline_smoothing = 1.5; },
                   "--spline_smoothing=1.5: allowed 0 to 1"},
         BadOption{"UnknownPrior", [](SlamOptions* o) { o->prior = "brownian"; },
-                  "--prior=brownian: unknown prior; allowed rff or wnoa"},
+                  "--prior=brownian: unknown prior; allowed rff, wnoa or wnoj"},
         BadOption{"WnoaMeanOfTheWnoaPrior",
                   [](SlamOptions* o) {
                     o->prior = "wnoa";

@@ -25,6 +25,7 @@
 #include "rff_ceres/simulate.h"
 #include "rff_ceres/slam_report.h"
 #include "rff_ceres/slam_solver.h"
+#include "test/markov_draws.h"
 #include "test/trajectory_difference.h"
 
 namespace rff {
@@ -42,7 +43,7 @@ Dataset WnoaDraw(std::uint64_t seed, int steps, double qc_position,
   Eigen::Matrix2d q;
   q << 1.0 / 3.0, 0.5, 0.5, 1.0;
   const Eigen::Matrix2d l = q.llt().matrixL();
-  Dataset dataset;
+  std::vector<TimedPose> truth;
   Eigen::Vector3d p = Eigen::Vector3d::Zero(), v(0.5, 0.0, 0.0);
   for (int k = 0; k < steps; ++k) {
     if (k > 0) {
@@ -54,40 +55,9 @@ Dataset WnoaDraw(std::uint64_t seed, int steps, double qc_position,
         v[c] += w[1];
       }
     }
-    dataset.ground_truth.push_back({1.0 * k, p.x(), p.y(), p.z()});
-    if (k % 3 == 0) {
-      const LandmarkId id = k / 3;
-      const double side = (id % 2 == 0) ? 4.0 : -4.0;
-      Landmark l;
-      l.id = id;
-      l.x = p.x() - side * std::sin(p.z());
-      l.y = p.y() + side * std::cos(p.z());
-      dataset.ground_truth_landmarks.push_back(l);
-      dataset.landmark_priors.push_back({id, l.x, l.y, 0.01});
-    }
+    truth.push_back({1.0 * k, p.x(), p.y(), p.z()});
   }
-  for (const TimedPose& pose : dataset.ground_truth) {
-    for (const Landmark& l : dataset.ground_truth_landmarks) {
-      const double range = std::hypot(l.x - pose.x, l.y - pose.y);
-      if (range > 12.0) continue;
-      Observation o;
-      o.type = ObservationType::kRangeBearing;
-      o.t = pose.t;
-      o.id = l.id;
-      o.sigma_range = 0.05;
-      o.sigma_bearing = 0.01;
-      o.range = range + o.sigma_range * normal(engine);
-      o.bearing = WrapAngle(std::atan2(l.y - pose.y, l.x - pose.x) -
-                            pose.theta + o.sigma_bearing * normal(engine));
-      dataset.observations.push_back(o);
-    }
-  }
-  PosePrior start;
-  start.pose = dataset.ground_truth.front();
-  start.sigma_xy = 0.01;
-  start.sigma_theta = 0.01;
-  dataset.pose_priors.push_back(start);
-  return dataset;
+  return testing::SightedDraw(truth, 1, [&] { return normal(engine); });
 }
 
 // On a draw from the prior with known densities, alternating MAP solves and

@@ -16,23 +16,12 @@
 #include "rff_ceres/metrics.h"
 #include "rff_ceres/simulate.h"
 #include "rff_ceres/slam_problem.h"
+#include "test/markov_draws.h"
 
 namespace rff {
 namespace {
 
-// A mean that is easy to tell apart from the deviation: linear in time
-// (relative to `origin`, so epoch times keep their digits).
-class LinearMean : public MeanFunction {
- public:
-  explicit LinearMean(double origin) : origin_(origin) {}
-  Eigen::Vector3d Evaluate(double t) const override {
-    const double u = t - origin_;
-    return Eigen::Vector3d(1.0 + 0.5 * u, -2.0 + 0.25 * u, 0.1 * u);
-  }
-
- private:
-  double origin_;
-};
+using testing::LinearMean;
 
 std::unique_ptr<WnoaTrajectory> MakeTrajectory(
     const std::vector<double>& times, const WnoaOptions& options = {}) {

@@ -69,7 +69,7 @@ def test_the_clis_file_flags_point_to_the_python_way(small, name, hint):
     ({"lengthscale": "long"}, "--lengthscale=long: not a valid double"),
     ({"estimate_range_calibration": "perhaps"},
      "--estimate_range_calibration=perhaps: not a valid bool"),
-    ({"prior": "gp"}, "--prior=gp: unknown prior; allowed rff or wnoa"),
+    ({"prior": "gp"}, "--prior=gp: unknown prior; allowed rff, wnoa or wnoj"),
     ({"num_features": -3}, "num_features"),
     ({"lengthscale": [1.0]}, "option 'lengthscale' must be a bool, int, "
                              "float or str, got list"),
@@ -102,6 +102,17 @@ def test_options_do_not_leak_into_the_next_solve(small, plain):
     assert again.summary["prior"] == "rff"
     np.testing.assert_array_equal(again.poses, plain.poses)
     assert rffslam.options()["lengthscale"]["default"] == "10"
+
+
+def test_each_markov_prior_keeps_its_own_diffusion(small):
+    # WNOJ's Q_c is a jerk's (m^2/s^5): its own option, its own summary key.
+    wnoj = rffslam.solve(small, prior="wnoj", wnoj_position_qc=0.25,
+                         wnoa_position_qc=4.0)
+    assert wnoj.summary["prior"] == "wnoj"
+    assert wnoj.summary["wnoj_position_qc"] == 0.25
+    assert wnoj.summary["wnoa_position_qc"] == 4.0
+    assert np.isfinite(wnoj.poses).all()
+    assert len(wnoj.poses) == len(rffslam.solve(small, prior="wnoa").poses)
 
 
 def test_solves_in_threads_agree(small, plain):
@@ -145,7 +156,7 @@ def test_flagfile_errors_name_the_file_and_line(small, tmp_path):
         ("prior=wnoa\n", ":1: expected --name=value"),
         ("--v=2\n", ":1: unknown flag '--v'"),
         ("--output_trajectory=x.tum\n", ":1: unknown flag"),
-        ("--prior=gp\n", "--prior=gp: unknown prior; allowed rff or wnoa"),
+        ("--prior=gp\n", "--prior=gp: unknown prior; allowed rff, wnoa or wnoj"),
     ]
     for i, (text, message) in enumerate(cases):
         path = flagfile(tmp_path, text, f"case{i}.flags")

@@ -16,6 +16,7 @@ const std::vector<const TrajectoryPrior*>& Registry() {
   static const auto* registry = new std::vector<const TrajectoryPrior*>{
       &FeaturePrior(),
       &WnoaPrior(),
+      &WnojPrior(),
   };
   return *registry;
 }

@@ -61,10 +61,19 @@ class TrajectoryPrior {
                           std::ostream* out) const = 0;
 };
 
-// The registered priors, one file each: "rff" (feature_prior.cc) and "wnoa"
-// (wnoa_prior.cc).
+// The registered priors, one file each: "rff" (feature_prior.cc), "wnoa"
+// (wnoa_prior.cc) and "wnoj" (wnoj_prior.cc).
 const TrajectoryPrior& FeaturePrior();
 const TrajectoryPrior& WnoaPrior();
+const TrajectoryPrior& WnojPrior();
+
+// The times the Markov-state priors (wnoa, wnoj) keep a state at: every
+// observation time and both ends of the data; about a "constant" mean
+// (`mean_name` as settled) both ends of every odometry chain too. False
+// with `error` where the odometry does not chain.
+bool StateTimes(const Dataset& dataset, const SlamOptions& options,
+                const std::string& mean_name, std::vector<double>* times,
+                std::string* error);
 
 // The mean at the origin the priors' CheckOptions build on.
 std::shared_ptr<const MeanFunction> UnitWindowMean();

@@ -14,7 +14,7 @@ namespace {
 
 // Every time the data constrain: the states reach both ends. Ground truth
 // only asks for outputs, which beyond the states extrapolate at constant
-// velocity (the WNOA posterior mean there).
+// velocity or acceleration (the posterior mean there).
 void TimeSpan(const Dataset& dataset, double* begin, double* end) {
   std::vector<double> times;
   for (const Observation& o : dataset.observations) times.push_back(o.t);
@@ -43,23 +43,9 @@ class WnoaPriorImpl : public TrajectoryPrior {
       const Dataset& dataset, const SlamOptions& options,
       const std::string& mean_name, std::shared_ptr<const MeanFunction> mean,
       std::string* error) const override {
-    // A state at every distinct observation time, and at both ends of the
-    // data (ground truth beyond them extrapolates). A constant mean leaves
-    // the motion to the states: one at each end of every odometry residual
-    // too, or the cubic between states could not follow it (a 64 s stretch
-    // without observations would be one cubic).
-    double t_begin, t_end;
-    TimeSpan(dataset, &t_begin, &t_end);
-    std::vector<double> times = {t_begin, t_end};
-    for (const Observation& o : dataset.observations) times.push_back(o.t);
-    std::vector<PreintegratedOdometry> chains;
-    if (mean_name == "constant" &&
-        !OdometryChains(dataset, options.problem, &chains, error)) {
+    std::vector<double> times;
+    if (!StateTimes(dataset, options, mean_name, &times, error)) {
       return nullptr;
-    }
-    for (const PreintegratedOdometry& chain : chains) {
-      times.push_back(chain.t0);
-      times.push_back(chain.t1);
     }
     return WnoaTrajectory::Create(options.wnoa, std::move(mean),
                                   std::move(times), error);
@@ -82,6 +68,30 @@ class WnoaPriorImpl : public TrajectoryPrior {
 };
 
 }  // namespace
+
+bool StateTimes(const Dataset& dataset, const SlamOptions& options,
+                const std::string& mean_name, std::vector<double>* times,
+                std::string* error) {
+  // A state at every distinct observation time, and at both ends of the
+  // data (ground truth beyond them extrapolates). A constant mean leaves
+  // the motion to the states: one at each end of every odometry residual
+  // too, or the polynomial between states could not follow it (a 64 s
+  // stretch without observations would be one cubic).
+  double t_begin, t_end;
+  TimeSpan(dataset, &t_begin, &t_end);
+  *times = {t_begin, t_end};
+  for (const Observation& o : dataset.observations) times->push_back(o.t);
+  std::vector<PreintegratedOdometry> chains;
+  if (mean_name == "constant" &&
+      !OdometryChains(dataset, options.problem, &chains, error)) {
+    return false;
+  }
+  for (const PreintegratedOdometry& chain : chains) {
+    times->push_back(chain.t0);
+    times->push_back(chain.t1);
+  }
+  return true;
+}
 
 const TrajectoryPrior& WnoaPrior() {
   static const auto* prior = new WnoaPriorImpl;

@@ -29,13 +29,15 @@ Dataset TenSeconds() {
 }
 
 TEST(TrajectoryPriorTest, RegistryNamesEachPriorOnce) {
-  EXPECT_EQ(PriorNames(), (std::vector<std::string>{"rff", "wnoa"}));
+  EXPECT_EQ(PriorNames(), (std::vector<std::string>{"rff", "wnoa", "wnoj"}));
   EXPECT_EQ(FindPrior("rff"), &FeaturePrior());
   EXPECT_EQ(FindPrior("wnoa"), &WnoaPrior());
+  EXPECT_EQ(FindPrior("wnoj"), &WnojPrior());
   EXPECT_EQ(FindPrior("brownian"), nullptr);
   EXPECT_EQ(FindPrior(""), nullptr);
   EXPECT_TRUE(FindPrior("rff")->has_features());
   EXPECT_FALSE(FindPrior("wnoa")->has_features());
+  EXPECT_FALSE(FindPrior("wnoj")->has_features());
 }
 
 TEST(TrajectoryPriorTest, ScalesAreTheOptionsLearningRescales) {
@@ -52,6 +54,13 @@ TEST(TrajectoryPriorTest, ScalesAreTheOptionsLearningRescales) {
   EXPECT_EQ(options.wnoa.position_qc, 4.0);
   EXPECT_EQ(options.wnoa.heading_qc, 5.0);
   EXPECT_STREQ(wnoa.scales_name(), "Q_c");
+  const TrajectoryPrior& wnoj = *FindPrior("wnoj");
+  *wnoj.PositionScale(&options) = 6.0;
+  *wnoj.HeadingScale(&options) = 7.0;
+  EXPECT_EQ(options.wnoj.position_qc, 6.0);
+  EXPECT_EQ(options.wnoj.heading_qc, 7.0);
+  EXPECT_EQ(options.wnoa.position_qc, 4.0);  // Each prior its own scales.
+  EXPECT_STREQ(wnoj.scales_name(), "Q_c");
 }
 
 TEST(TrajectoryPriorTest, FactoryBuildsTheNamedModel) {
@@ -66,6 +75,14 @@ TEST(TrajectoryPriorTest, FactoryBuildsTheNamedModel) {
   ASSERT_NE(wnoa, nullptr) << error;
   EXPECT_EQ(wnoa->num_blocks(), 11);  // A state at each record's time.
   EXPECT_FALSE(wnoa->HasDenseReducedSystem());
+  EXPECT_EQ(wnoa->block_size(0), 6);
+  options.prior = "wnoj";
+  std::unique_ptr<TrajectoryModel> wnoj =
+      CreateTrajectoryModel(dataset, options, mean, &error);
+  ASSERT_NE(wnoj, nullptr) << error;
+  EXPECT_EQ(wnoj->num_blocks(), 11);  // The same state times.
+  EXPECT_EQ(wnoj->block_size(0), 9);  // Position, velocity, acceleration.
+  EXPECT_FALSE(wnoj->HasDenseReducedSystem());
   options.prior = "rff";
   std::unique_ptr<TrajectoryModel> rff =
       CreateTrajectoryModel(dataset, options, mean, &error);
@@ -80,7 +97,8 @@ TEST(TrajectoryPriorTest, UnknownPriorIsAnOptionError) {
   EXPECT_EQ(
       CreateTrajectoryModel(TenSeconds(), options, UnitWindowMean(), &error),
       nullptr);
-  EXPECT_EQ(error, "--prior=brownian: unknown prior; allowed rff or wnoa");
+  EXPECT_EQ(error,
+            "--prior=brownian: unknown prior; allowed rff, wnoa or wnoj");
 }
 
 TEST(TrajectoryPriorTest, WnoaModelLine) {
@@ -93,6 +111,18 @@ TEST(TrajectoryPriorTest, WnoaModelLine) {
   EXPECT_EQ(out.str(),
             "  model        WNOA (LTV-SDE) prior, Q_c = 0.5 (x, y), 0.25 "
             "(theta), constant mean\n");
+}
+
+TEST(TrajectoryPriorTest, WnojModelLine) {
+  SlamResult result;
+  result.wnoj_options.position_qc = 0.125;
+  result.wnoj_options.heading_qc = 2.0;
+  result.prior_mean = "constant";
+  std::ostringstream out;
+  FindPrior("wnoj")->PrintModel(result, &out);
+  EXPECT_EQ(out.str(),
+            "  model        WNOJ (white noise on jerk) prior, Q_c = 0.125 (x, "
+            "y), 2 (theta), constant mean\n");
 }
 
 }  // namespace
