@@ -1,16 +1,22 @@
 // Helpers for tests of the Markov-state priors (WNOA, WNOJ): a mean easy to
-// tell from the states' deviation, and a known map beside a drawn path.
+// tell from the states' deviation, a known map beside a drawn path, and the
+// consistency of a solve's covariances.
 #ifndef RFF_TEST_MARKOV_DRAWS_H_
 #define RFF_TEST_MARKOV_DRAWS_H_
 
 #include <cmath>
 #include <cstddef>
 #include <functional>
+#include <string>
 #include <vector>
 
 #include "Eigen/Core"
+#include "gtest/gtest.h"
+#include "rff_ceres/consistency.h"
+#include "rff_ceres/io/pose_covariance_io.h"
 #include "rff_ceres/io/text_parser.h"
 #include "rff_ceres/mean/mean_function.h"
+#include "rff_ceres/slam_solver.h"
 #include "rff_ceres/types.h"
 
 namespace rff {
@@ -73,6 +79,32 @@ inline Dataset SightedDraw(const std::vector<TimedPose>& truth, int every,
   start.sigma_theta = 0.01;
   dataset.pose_priors.push_back(start);
   return dataset;
+}
+
+// The mean position NEES of `prior`'s default solve of `dataset` (its pose
+// covariances against the truth); a failure is recorded, and gives NaN.
+inline double SolvedPositionNees(const Dataset& dataset,
+                                 const std::string& prior, SlamResult* result) {
+  SlamOptions options;
+  options.prior = prior;
+  options.output.covariance = true;
+  std::string error;
+  Evaluation evaluation;
+  evaluation.consistency.mean_position_nees = NAN;
+  if (!RunSlam(dataset, options, result, &error)) {
+    ADD_FAILURE() << error;
+    return NAN;
+  }
+  std::vector<PoseCovariance> covariances;
+  for (std::size_t k = 0; k < result->trajectory.size(); ++k) {
+    covariances.push_back(
+        {result->trajectory[k].t, result->pose_covariances[k]});
+  }
+  if (!EvaluateConsistency(dataset.ground_truth, result->trajectory,
+                           covariances, &evaluation, &error)) {
+    ADD_FAILURE() << error;
+  }
+  return evaluation.consistency.mean_position_nees;
 }
 
 }  // namespace testing

@@ -730,29 +730,11 @@ TEST(VarianceComponentsTest, WnoaCovarianceIsConsistentOnItsOwnDraws) {
   int runs = 0;
   for (std::uint64_t seed = 1; seed <= 20; ++seed) {
     const Dataset dataset = WnoaDraw(seed, 150, 0.01, 1e-4);
-    SlamOptions options;
-    options.prior = "wnoa";
-    options.output.covariance = true;
     SlamResult result;
-    std::string error;
-    ASSERT_TRUE(RunSlam(dataset, options, &result, &error)) << error;
-    std::vector<PoseCovariance> covariances;
-    for (std::size_t k = 0; k < result.trajectory.size(); ++k) {
-      covariances.push_back(
-          {result.trajectory[k].t, result.pose_covariances[k]});
-    }
-    Evaluation evaluation;
-    ASSERT_TRUE(Evaluate(dataset.ground_truth, dataset.ground_truth_landmarks,
-                         result.trajectory, &result.landmarks,
-                         EvaluationOptions(), &evaluation, &error))
-        << error;
-    ASSERT_TRUE(EvaluateConsistency(dataset.ground_truth, result.trajectory,
-                                    covariances, &evaluation, &error))
-        << error;
+    const double nees = testing::SolvedPositionNees(dataset, "wnoa", &result);
     std::printf("seed %llu: position NEES %.3f\n",
-                static_cast<unsigned long long>(seed),
-                evaluation.consistency.mean_position_nees);
-    nees_sum += evaluation.consistency.mean_position_nees;
+                static_cast<unsigned long long>(seed), nees);
+    nees_sum += nees;
     ++runs;
   }
   const double pooled = nees_sum / runs;
