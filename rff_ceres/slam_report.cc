@@ -270,6 +270,11 @@ void WriteSummaryJson(const SlamOptions& options, const SlamResult& result,
       << (result.learning_converged ? "true" : "false") << ",\n"
       << "  \"learning_evidence_fell\": "
       << (result.learning_evidence_fell ? "true" : "false") << ",\n"
+      << "  \"model_log_evidence\": "
+      << (std::isfinite(result.model_log_evidence)
+              ? FormatNumber(result.model_log_evidence)
+              : "null")
+      << ",\n"
       << "  \"scale_log_evidence\": " << NumberList(result.scale_log_evidence)
       << ",\n"
       << "  \"noise_evidence_fell\": "

@@ -225,6 +225,14 @@ bool ReportSolution(const Dataset& dataset, const SlamOptions& options,
       wnoa_mean_solve.heading_windings_unwound.begin(),
       wnoa_mean_solve.heading_windings_unwound.end());
   PriorOf(options).RecordModel(model, result);
+  const std::vector<double>& evidence = result->scale_log_evidence;
+  if (!evidence.empty() && result->prior_mean == "constant" &&
+      !PriorOf(options).has_features()) {
+    // After a fall the rounds went back to the scales before it.
+    const bool fell = result->learning_evidence_fell && evidence.size() > 1;
+    result->model_log_evidence =
+        evidence[evidence.size() - (fell ? 2 : 1)] + model.PriorLogNormaliser();
+  }
   if (!problem->CheckLandmarksDetermined(1e12, error)) return false;
   if (options.output.quality) {
     // Judged against the data as stated: learned sigmas would absorb a

@@ -5,6 +5,7 @@
 #ifndef RFF_CERES_SLAM_SOLVER_H_
 #define RFF_CERES_SLAM_SOLVER_H_
 
+#include <limits>
 #include <map>
 #include <memory>
 #include <ostream>
@@ -76,6 +77,12 @@ struct SlamResult {
   // Empty under a robust loss, where it guards nothing.
   std::vector<double> scale_log_evidence;
   bool learning_evidence_fell = false;
+  // The Laplace log evidence of the data at the scales the learning rounds
+  // kept, with the prior's normaliser (TrajectoryModel::PriorLogNormaliser):
+  // comparable between the Markov priors on one file, where the rounds
+  // measured it (every loss settled to none) about a "constant" mean; NaN
+  // otherwise (a mean built from the data counts them twice).
+  double model_log_evidence = std::numeric_limits<double>::quiet_NaN();
   // The rounds that learned the noise sigmas (the WNOA mean's, for an RFF
   // prior about one) ended so.
   bool noise_evidence_fell = false;

@@ -179,6 +179,14 @@ void StateTrajectory::AddPriorCosts(ceres::Problem* problem, int begin,
   }
 }
 
+double StateTrajectory::PriorLogNormaliser() const {
+  double sum = InitialLogDet();
+  for (std::size_t i = 0; i + 1 < times_.size(); ++i) {
+    sum += MotionLogDet(times_[i + 1] - times_[i]);
+  }
+  return sum;
+}
+
 bool StateTrajectory::AdoptScales(TrajectoryModel* rescaled) {
   if (rescaled == nullptr || typeid(*rescaled) != typeid(*this)) return false;
   const auto& same = static_cast<const StateTrajectory&>(*rescaled);

@@ -55,6 +55,7 @@ class StateTrajectory : public TrajectoryModel {
   // mean and other options: the interpolations do not depend on Q_c, the
   // motion prior's costs do (UpdatePriorCosts).
   bool AdoptScales(TrajectoryModel* rescaled) override;
+  double PriorLogNormaliser() const override;
   void UpdatePriorCosts(
       const std::vector<ceres::CostFunction*>& costs) const override;
   // The motion prior's rows follow the state (position, position, heading,
@@ -105,6 +106,10 @@ class StateTrajectory : public TrajectoryModel {
   // Takes the Q_c of `rescaled`, of this model's type, where its other
   // options equal these; false, nothing changed, otherwise.
   virtual bool TakeScales(const StateTrajectory& rescaled) = 0;
+  // log |det S| of the initial-state prior, and of a motion cost `dt` apart
+  // at Q_c = 1 (PriorLogNormaliser).
+  virtual double InitialLogDet() const = 0;
+  virtual double MotionLogDet(double dt) const = 0;
 
   std::shared_ptr<const MeanFunction> mean_;
   std::vector<double> times_;   // Sorted, thinned state times.

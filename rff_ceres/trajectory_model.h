@@ -107,6 +107,11 @@ class TrajectoryModel {
   // AddPriorCosts would add. Nothing where the prior has no scale.
   virtual void UpdatePriorCosts(
       const std::vector<ceres::CostFunction*>& /*costs*/) const {}
+  // log |det S| summed over the prior's residual blocks, S their square-root
+  // information at unit scales: the normaliser of the prior's density that
+  // LaplaceLogEvidence leaves out (no scale changes it) and that differs
+  // between priors. 0 for weights whitened to N(0, I).
+  virtual double PriorLogNormaliser() const { return 0.0; }
 };
 
 // Every block's values in block order, and back (same model structure).

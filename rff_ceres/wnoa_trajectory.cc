@@ -115,6 +115,18 @@ ceres::CostFunction* WnoaTrajectory::NewInitialStateCost() const {
   return new WnoaInitialStateCost(sigma);
 }
 
+double WnoaTrajectory::InitialLogDet() const {
+  const WnoaOptions& o = options_;
+  return -std::log(o.initial_position_sigma * o.initial_position_sigma *
+                   o.initial_heading_sigma * o.initial_velocity_sigma *
+                   o.initial_velocity_sigma * o.initial_angular_velocity_sigma);
+}
+
+double WnoaTrajectory::MotionLogDet(double dt) const {
+  // det S_c = sqrt(3) / dt^3/2 * 2 / dt^1/2 per coordinate (wnoa_prior_cost.h).
+  return 3.0 * (std::log(2.0 * std::sqrt(3.0)) - 2.0 * std::log(dt));
+}
+
 ceres::CostFunction* WnoaTrajectory::NewMotionCost(double dt) const {
   return new WnoaPriorCost(dt, options_.position_qc, options_.position_qc,
                            options_.heading_qc);

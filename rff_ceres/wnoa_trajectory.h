@@ -96,6 +96,8 @@ class WnoaTrajectory : public StateTrajectory {
   ceres::CostFunction* NewMotionCost(double dt) const override;
   void SetMotionQc(ceres::CostFunction* cost) const override;
   bool TakeScales(const StateTrajectory& rescaled) override;
+  double InitialLogDet() const override;
+  double MotionLogDet(double dt) const override;
 
   WnoaOptions options_;
 };

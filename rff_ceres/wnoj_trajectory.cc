@@ -1,6 +1,7 @@
 #include "rff_ceres/wnoj_trajectory.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include "Eigen/Core"
 #include "costs/diagonal_prior_cost.h"
@@ -120,6 +121,22 @@ ceres::CostFunction* WnojTrajectory::NewInitialStateCost() const {
       options_.initial_acceleration_sigma, options_.initial_acceleration_sigma,
       options_.initial_angular_acceleration_sigma;
   return new DiagonalPriorCost(Eigen::VectorXd::Zero(kStateSize), sigma);
+}
+
+double WnojTrajectory::InitialLogDet() const {
+  const WnoaOptions& s = states_options_;
+  const WnojOptions& o = options_;
+  return -std::log(s.initial_position_sigma * s.initial_position_sigma *
+                   s.initial_heading_sigma * s.initial_velocity_sigma *
+                   s.initial_velocity_sigma * s.initial_angular_velocity_sigma *
+                   o.initial_acceleration_sigma * o.initial_acceleration_sigma *
+                   o.initial_angular_acceleration_sigma);
+}
+
+double WnojTrajectory::MotionLogDet(double dt) const {
+  // det S_c = det M / dt^(5 + 3 + 1)/2, det M = 2 sqrt(5) 4 sqrt(3) 3
+  // (wnoj_prior_cost.h).
+  return 3.0 * (std::log(24.0 * std::sqrt(15.0)) - 4.5 * std::log(dt));
 }
 
 ceres::CostFunction* WnojTrajectory::NewMotionCost(double dt) const {

@@ -85,6 +85,8 @@ class WnojTrajectory : public StateTrajectory {
   ceres::CostFunction* NewMotionCost(double dt) const override;
   void SetMotionQc(ceres::CostFunction* cost) const override;
   bool TakeScales(const StateTrajectory& rescaled) override;
+  double InitialLogDet() const override;
+  double MotionLogDet(double dt) const override;
 
   WnojOptions options_;
   WnoaOptions states_options_;
