@@ -1,6 +1,7 @@
 #include "slam_flags.h"
 
 #include "gflags/gflags.h"
+#include "rff_ceres/priors/trajectory_prior.h"
 
 // Trajectory prior.
 DEFINE_string(prior, "rff",
@@ -70,13 +71,15 @@ DEFINE_string(learn_hyperparameters, "auto",
               "auto. RFF: lengthscales and variances of x, y and theta by the "
               "evidence of the exact kernel with the observations linearised "
               "about a WNOA solve (auto: without odometry), and the variances "
-              "of the correction to a wnoa mean; WNOA: Q_c and the factors "
+              "of the correction to a wnoa mean; WNOA and WNOJ: Q_c and the "
+              "factors "
               "on the data's stated sigmas (range, bearing, odometry) by "
               "variance components (Q_c kept where the data leave the "
               "size loose), the RFF prior solving with those of its "
-              "WNOA mean. Batch mode only. auto is off when a kernel "
-              "hyperparameter or Q_c is given (command line or flagfile): "
-              "they are then the user's choice.");
+              "WNOA mean. Batch mode only. auto is off when a scale of the "
+              "chosen prior is given (command line or flagfile; for rff its "
+              "kernel hyperparameters and WNOA's Q_c): they are then the "
+              "user's choice.");
 DEFINE_uint64(seed, 1,
               "Seed of the random feature frequencies, 0 to 2^64 - 1.");
 DEFINE_double(segment_length, 0.0,
@@ -231,14 +234,16 @@ DEFINE_double(decrement_tolerance, 0.01,
 namespace rff {
 namespace {
 
-// True when the user set a kernel hyperparameter (command line or flagfile):
-// "auto" learning then keeps the user's values.
-bool KernelHyperparametersGiven() {
-  for (const char* flag :
-       {"lengthscale", "kernel_variance", "heading_lengthscale",
-        "heading_kernel_variance", "wnoa_position_qc", "wnoa_heading_qc",
-        "wnoj_position_qc", "wnoj_heading_qc"}) {
-    if (!gflags::GetCommandLineFlagInfoOrDie(flag).is_default) return true;
+// True when the user set a scale of the chosen prior, or of the WNOA solve an
+// RFF prior starts from (command line or flagfile): "auto" learning then
+// keeps the user's values. Another prior's scales leave it alone.
+bool PriorScalesGiven() {
+  const TrajectoryPrior* prior = FindPrior(FLAGS_prior);
+  if (prior == nullptr) return false;  // Validation names the prior.
+  for (const std::string& flag : prior->scale_flags()) {
+    if (!gflags::GetCommandLineFlagInfoOrDie(flag.c_str()).is_default) {
+      return true;
+    }
   }
   return false;
 }
@@ -274,7 +279,7 @@ SlamOptions SlamOptionsFromFlags() {
   options.incremental.lag = FLAGS_incremental_lag;
   options.mean.outer_rounds = FLAGS_outer_rounds;
   options.learn_hyperparameters = FLAGS_learn_hyperparameters;
-  if (options.learn_hyperparameters == "auto" && KernelHyperparametersGiven()) {
+  if (options.learn_hyperparameters == "auto" && PriorScalesGiven()) {
     options.learn_hyperparameters = "off";
   }
   options.mean.spline_smoothing = FLAGS_spline_smoothing;

@@ -85,6 +85,8 @@ void PrintSlamSummary(const SlamOptions& options, const SlamResult& result,
          << (result.learning_converged ? ""
              : result.learning_evidence_fell
                  ? " (ended at the round before the Laplace evidence fell)"
+             : !result.scales_not_learned.empty()
+                 ? " (stopped short: see the warning)"
                  : " (stopped at the round cap, the factors still moving)");
     const char* separator = "; at zero, the data leave no variance to: ";
     for (const std::string& group : result.scales_at_boundary) {

@@ -226,7 +226,10 @@ bool ReportSolution(const Dataset& dataset, const SlamOptions& options,
       wnoa_mean_solve.heading_windings_unwound.end());
   PriorOf(options).RecordModel(model, result);
   const std::vector<double>& evidence = result->scale_log_evidence;
-  if (!evidence.empty() && result->prior_mean == "constant" &&
+  // Not where the learning stopped short, or outer rounds refitted the mean
+  // to the estimate.
+  if (!evidence.empty() && result->scales_not_learned.empty() &&
+      result->prior_mean == "constant" && options.mean.outer_rounds == 0 &&
       !PriorOf(options).has_features()) {
     // After a fall the rounds went back to the scales before it.
     const bool fell = result->learning_evidence_fell && evidence.size() > 1;

@@ -80,8 +80,9 @@ struct SlamResult {
   // The Laplace log evidence of the data at the scales the learning rounds
   // kept, with the prior's normaliser (TrajectoryModel::PriorLogNormaliser):
   // comparable between the Markov priors on one file, where the rounds
-  // measured it (every loss settled to none) about a "constant" mean; NaN
-  // otherwise (a mean built from the data counts them twice).
+  // measured it (every loss settled to none, every round factorised) about
+  // a "constant" mean no outer round refitted; NaN otherwise (a mean built
+  // from the data counts them twice).
   double model_log_evidence = std::numeric_limits<double>::quiet_NaN();
   // The rounds that learned the noise sigmas (the WNOA mean's, for an RFF
   // prior about one) ended so.

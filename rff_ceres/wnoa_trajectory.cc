@@ -117,9 +117,11 @@ ceres::CostFunction* WnoaTrajectory::NewInitialStateCost() const {
 
 double WnoaTrajectory::InitialLogDet() const {
   const WnoaOptions& o = options_;
-  return -std::log(o.initial_position_sigma * o.initial_position_sigma *
-                   o.initial_heading_sigma * o.initial_velocity_sigma *
-                   o.initial_velocity_sigma * o.initial_angular_velocity_sigma);
+  // A sum of logs: the product of six sigmas leaves double's range first.
+  return -(2.0 * std::log(o.initial_position_sigma) +
+           std::log(o.initial_heading_sigma) +
+           2.0 * std::log(o.initial_velocity_sigma) +
+           std::log(o.initial_angular_velocity_sigma));
 }
 
 double WnoaTrajectory::MotionLogDet(double dt) const {

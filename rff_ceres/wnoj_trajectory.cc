@@ -124,13 +124,15 @@ ceres::CostFunction* WnojTrajectory::NewInitialStateCost() const {
 }
 
 double WnojTrajectory::InitialLogDet() const {
-  const WnoaOptions& s = states_options_;
   const WnojOptions& o = options_;
-  return -std::log(s.initial_position_sigma * s.initial_position_sigma *
-                   s.initial_heading_sigma * s.initial_velocity_sigma *
-                   s.initial_velocity_sigma * s.initial_angular_velocity_sigma *
-                   o.initial_acceleration_sigma * o.initial_acceleration_sigma *
-                   o.initial_angular_acceleration_sigma);
+  const WnoaOptions& s = states_options_;
+  // WNOA's six sigmas, then the accelerations', each as a log.
+  return -(2.0 * std::log(s.initial_position_sigma) +
+           std::log(s.initial_heading_sigma) +
+           2.0 * std::log(s.initial_velocity_sigma) +
+           std::log(s.initial_angular_velocity_sigma) +
+           2.0 * std::log(o.initial_acceleration_sigma) +
+           std::log(o.initial_angular_acceleration_sigma));
 }
 
 double WnojTrajectory::MotionLogDet(double dt) const {

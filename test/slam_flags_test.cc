@@ -3,7 +3,9 @@
 // line gets.
 #include "apps/slam_flags.h"
 
+#include "gflags/gflags.h"
 #include "gtest/gtest.h"
+#include "rff_ceres/priors/trajectory_prior.h"
 #include "rff_ceres/slam_solver.h"
 
 namespace rff {
@@ -32,6 +34,13 @@ TEST(SlamFlagsTest, DefaultFlagsGiveTheLibraryDefaults) {
             library.localization.correction_smoothing);
   EXPECT_EQ(flags.localization.use_odometry, library.localization.use_odometry);
   EXPECT_EQ(flags.wnoa.position_qc, library.wnoa.position_qc);
+  EXPECT_EQ(flags.wnoj.position_qc, library.wnoj.position_qc);
+  EXPECT_EQ(flags.wnoj.heading_qc, library.wnoj.heading_qc);
+  EXPECT_EQ(flags.wnoj.initial_acceleration_sigma,
+            library.wnoj.initial_acceleration_sigma);
+  EXPECT_EQ(flags.wnoj.initial_angular_acceleration_sigma,
+            library.wnoj.initial_angular_acceleration_sigma);
+  EXPECT_EQ(flags.wnoj.min_state_spacing, library.wnoj.min_state_spacing);
   EXPECT_EQ(flags.wnoa.heading_qc, library.wnoa.heading_qc);
   EXPECT_EQ(flags.wnoa.initial_position_sigma,
             library.wnoa.initial_position_sigma);
@@ -88,6 +97,39 @@ TEST(SlamFlagsTest, DefaultFlagsGiveTheLibraryDefaults) {
   EXPECT_EQ(s.parameter_tolerance, library.solver.parameter_tolerance);
   EXPECT_EQ(s.decrement_tolerance, library.solver.decrement_tolerance);
   EXPECT_EQ(s.max_memory_gb, library.solver.max_memory_gb);
+}
+
+// A scale the user gives keeps "auto" learning off for the prior it
+// belongs to (and for an RFF prior, whose WNOA mean uses WNOA's), not for
+// the others: a WNOA flagfile run with --prior=wnoj still learns.
+TEST(SlamFlagsTest, OnlyTheChosenPriorsScalesKeepLearningOff) {
+  struct Case {
+    const char* prior;
+    const char* flag;
+    const char* learning;
+  };
+  for (const Case& c : {Case{"wnoa", "wnoj_position_qc", "auto"},
+                        Case{"wnoj", "wnoj_position_qc", "off"},
+                        Case{"wnoj", "wnoa_heading_qc", "auto"},
+                        Case{"wnoj", "lengthscale", "auto"},
+                        Case{"wnoa", "wnoa_heading_qc", "off"},
+                        Case{"rff", "wnoa_position_qc", "off"},
+                        Case{"rff", "heading_lengthscale", "off"},
+                        Case{"rff", "wnoj_heading_qc", "auto"}}) {
+    gflags::FlagSaver saver;
+    gflags::SetCommandLineOption("prior", c.prior);
+    gflags::SetCommandLineOption(c.flag, "2");
+    EXPECT_EQ(SlamOptionsFromFlags().learn_hyperparameters, c.learning)
+        << "--prior=" << c.prior << " --" << c.flag << "=2";
+  }
+}
+
+TEST(SlamFlagsTest, EveryPriorsScaleFlagsAreSolverFlags) {
+  for (const std::string& name : PriorNames()) {
+    for (const std::string& flag : FindPrior(name)->scale_flags()) {
+      EXPECT_TRUE(IsSlamFlag(flag)) << name << ": " << flag;
+    }
+  }
 }
 
 TEST(SlamFlagsTest, IsSlamFlagKnowsTheSolverFlagsOnly) {

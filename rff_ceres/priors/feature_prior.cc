@@ -35,6 +35,11 @@ class FeaturePriorImpl : public TrajectoryPrior {
     return &options->features.heading_kernel.variance;
   }
   const char* scales_name() const override { return "variances"; }
+  std::vector<std::string> scale_flags() const override {
+    return {"lengthscale",         "kernel_variance",
+            "heading_lengthscale", "heading_kernel_variance",
+            "wnoa_position_qc",    "wnoa_heading_qc"};
+  }
 
   void RecordModel(const TrajectoryModel& model,
                    SlamResult* result) const override {

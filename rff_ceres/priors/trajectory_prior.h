@@ -50,6 +50,10 @@ class TrajectoryPrior {
   virtual double* PositionScale(SlamOptions* options) const = 0;
   virtual double* HeadingScale(SlamOptions* options) const = 0;
   virtual const char* scales_name() const = 0;
+  // The flags that set those scales, and any other solve's the prior
+  // starts from (an RFF prior's WNOA mean): given by the user, "auto"
+  // learning keeps them.
+  virtual std::vector<std::string> scale_flags() const = 0;
 
   // Copies into `result` what the model settled when it was built (a
   // feature count the capacity rule chose); nothing by default.

@@ -58,6 +58,9 @@ class WnoaPriorImpl : public TrajectoryPrior {
     return &options->wnoa.heading_qc;
   }
   const char* scales_name() const override { return "Q_c"; }
+  std::vector<std::string> scale_flags() const override {
+    return {"wnoa_position_qc", "wnoa_heading_qc"};
+  }
 
   void PrintModel(const SlamResult& result, std::ostream* out) const override {
     *out << "  model        WNOA (LTV-SDE) prior, Q_c = "

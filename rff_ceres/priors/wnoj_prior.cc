@@ -40,6 +40,9 @@ class WnojPriorImpl : public TrajectoryPrior {
     return &options->wnoj.heading_qc;
   }
   const char* scales_name() const override { return "Q_c"; }
+  std::vector<std::string> scale_flags() const override {
+    return {"wnoj_position_qc", "wnoj_heading_qc"};
+  }
 
   void PrintModel(const SlamResult& result, std::ostream* out) const override {
     *out << "  model        WNOJ (white noise on jerk) prior, Q_c = "

@@ -6,6 +6,7 @@
 
 #include "gtest/gtest.h"
 #include "rff_ceres/mean/mean_function.h"
+#include "rff_ceres/slam_report.h"
 #include "rff_ceres/slam_solver.h"
 
 namespace rff {
@@ -123,6 +124,32 @@ TEST(TrajectoryPriorTest, WnojModelLine) {
   EXPECT_EQ(out.str(),
             "  model        WNOJ (white noise on jerk) prior, Q_c = 0.125 (x, "
             "y), 2 (theta), constant mean\n");
+}
+
+// Rounds that stopped at a failed factorisation are not rounds that ran to
+// the cap: the scales line says so, and the warning says why.
+TEST(TrajectoryPriorTest, ScalesLineOfRoundsThatStoppedShort) {
+  SlamOptions options;
+  options.prior = "wnoj";
+  SlamResult result;
+  result.prior_mean = "constant";
+  result.learning_rounds = 3;
+  result.scales_not_learned =
+      "the Gauss-Newton Hessian is not positive definite";
+  std::ostringstream out;
+  PrintSlamSummary(options, result, &out);
+  EXPECT_NE(out.str().find("  scales       Q_c learned by variance "
+                           "components, 3 rounds (stopped short: see the "
+                           "warning)\n"),
+            std::string::npos)
+      << out.str();
+  result.scales_not_learned.clear();
+  std::ostringstream capped;
+  PrintSlamSummary(options, result, &capped);
+  EXPECT_NE(capped.str().find("3 rounds (stopped at the round cap, the "
+                              "factors still moving)"),
+            std::string::npos)
+      << capped.str();
 }
 
 }  // namespace
