@@ -34,24 +34,35 @@ class WnojPriorCost : public ceres::SizedCostFunction<9, 9, 9> {
     SetQc(qc_x, qc_y, qc_theta);
   }
 
-  // The cost the constructor builds with these densities (a learning
-  // round's rescale, in place).
-  void SetQc(double qc_x, double qc_y, double qc_theta) {
-    const double qc[3] = {qc_x, qc_y, qc_theta};
-    const double sqrt_dt = std::sqrt(dt_);
+  // One coordinate's S_c = qc^-1/2 M D^-1, acting on (p, v, a).
+  static Eigen::Matrix3d CoordinateSqrtInformation(double dt, double qc) {
+    const double sqrt_dt = std::sqrt(dt);
     // D^-1 = diag(dt^-5/2, dt^-3/2, dt^-1/2).
-    const double inv_d[3] = {1.0 / (dt_ * dt_ * sqrt_dt), 1.0 / (dt_ * sqrt_dt),
+    const double inv_d[3] = {1.0 / (dt * dt * sqrt_dt), 1.0 / (dt * sqrt_dt),
                              1.0 / sqrt_dt};
     const double m[3][3] = {{2.0 * std::sqrt(5.0), 0.0, 0.0},
                             {-10.0 * std::sqrt(3.0), 4.0 * std::sqrt(3.0), 0.0},
                             {20.0, -12.0, 3.0}};
+    const double scale = 1.0 / std::sqrt(qc);
+    Eigen::Matrix3d s = Eigen::Matrix3d::Zero();
+    for (int row = 0; row < 3; ++row) {
+      for (int col = 0; col <= row; ++col) {
+        s(row, col) = scale * m[row][col] * inv_d[col];
+      }
+    }
+    return s;
+  }
+
+  // The cost the constructor builds with these densities (a learning
+  // round's rescale, in place).
+  void SetQc(double qc_x, double qc_y, double qc_theta) {
+    const double qc[3] = {qc_x, qc_y, qc_theta};
     sqrt_information_.setZero();
     for (int c = 0; c < 3; ++c) {
-      const double scale = 1.0 / std::sqrt(qc[c]);
+      const Eigen::Matrix3d s = CoordinateSqrtInformation(dt_, qc[c]);
       for (int row = 0; row < 3; ++row) {
         for (int col = 0; col <= row; ++col) {
-          sqrt_information_(c + 3 * row, c + 3 * col) =
-              scale * m[row][col] * inv_d[col];
+          sqrt_information_(c + 3 * row, c + 3 * col) = s(row, col);
         }
       }
     }

@@ -108,8 +108,12 @@ void StateTrajectory::SetStatesFromPoses(const std::vector<TimedPose>& poses) {
     }
   }
   for (int c = 0; c < 3; ++c) {
-    for (int i = 0; i < n; ++i) mutable_block(i)[c] = deviation[i][c];
-    SetSmoothestDerivatives(c);
+    std::vector<double> positions(n);
+    for (int i = 0; i < n; ++i) {
+      positions[i] = deviation[i][c];
+      mutable_block(i)[c] = positions[i];
+    }
+    SetSmoothestDerivatives(c, positions);
   }
 }
 
@@ -180,7 +184,9 @@ void StateTrajectory::AddPriorCosts(ceres::Problem* problem, int begin,
 }
 
 double StateTrajectory::PriorLogNormaliser() const {
-  double sum = InitialLogDet();
+  // The first state's -sum log sigma, as logs: a product of sigmas leaves
+  // double's range first.
+  double sum = -InitialStateSigmas().array().log().sum();
   for (std::size_t i = 0; i + 1 < times_.size(); ++i) {
     sum += MotionLogDet(times_[i + 1] - times_[i]);
   }

@@ -93,11 +93,14 @@ class StateTrajectory : public TrajectoryModel {
   // interval of length `dt` = t_{i+1} - t_i > 0.
   virtual void PositionRows(double elapsed, double dt, double* lambda,
                             double* psi) const = 0;
-  // Sets the derivatives of coordinate `c` at every state, its positions
-  // already set, to the smoothest under the prior.
-  virtual void SetSmoothestDerivatives(int c) = 0;
-  // The prior's costs: on the first state, and between two states `dt` > 0
-  // apart with the current Q_c.
+  // Sets the derivatives of coordinate `c` at every state, whose
+  // `positions` are set, to the smoothest under the prior.
+  virtual void SetSmoothestDerivatives(
+      int c, const std::vector<double>& positions) = 0;
+  // The first state's prior sigmas, in state layout.
+  virtual Eigen::VectorXd InitialStateSigmas() const = 0;
+  // The prior's costs: on the first state (of InitialStateSigmas), and
+  // between two states `dt` > 0 apart with the current Q_c.
   virtual ceres::CostFunction* NewInitialStateCost() const = 0;
   virtual ceres::CostFunction* NewMotionCost(double dt) const = 0;
   // Gives `cost`, where it is one of this model's motion costs, the current
@@ -106,9 +109,7 @@ class StateTrajectory : public TrajectoryModel {
   // Takes the Q_c of `rescaled`, of this model's type, where its other
   // options equal these; false, nothing changed, otherwise.
   virtual bool TakeScales(const StateTrajectory& rescaled) = 0;
-  // log |det S| of the initial-state prior, and of a motion cost `dt` apart
-  // at Q_c = 1 (PriorLogNormaliser).
-  virtual double InitialLogDet() const = 0;
+  // log |det S| of a motion cost `dt` apart at Q_c = 1 (PriorLogNormaliser).
   virtual double MotionLogDet(double dt) const = 0;
 
   std::shared_ptr<const MeanFunction> mean_;

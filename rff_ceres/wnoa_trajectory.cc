@@ -54,12 +54,10 @@ std::vector<double> WnoaTrajectory::SmoothestVelocities(
       });
 }
 
-void WnoaTrajectory::SetSmoothestDerivatives(int c) {
-  const int n = num_blocks();
-  std::vector<double> positions(n);
-  for (int i = 0; i < n; ++i) positions[i] = block(i)[c];
+void WnoaTrajectory::SetSmoothestDerivatives(
+    int c, const std::vector<double>& positions) {
   const std::vector<double> velocity = SmoothestVelocities(times_, positions);
-  for (int i = 0; i < n; ++i) mutable_block(i)[3 + c] = velocity[i];
+  for (int i = 0; i < num_blocks(); ++i) mutable_block(i)[3 + c] = velocity[i];
 }
 
 void WnoaTrajectory::InterpolationMatrices(double elapsed, double dt,
@@ -107,21 +105,20 @@ void WnoaTrajectory::SetMotionQc(ceres::CostFunction* cost) const {
   }
 }
 
-ceres::CostFunction* WnoaTrajectory::NewInitialStateCost() const {
-  WnoaInitialStateCost::Vector6 sigma;
-  sigma << options_.initial_position_sigma, options_.initial_position_sigma,
-      options_.initial_heading_sigma, options_.initial_velocity_sigma,
-      options_.initial_velocity_sigma, options_.initial_angular_velocity_sigma;
-  return new WnoaInitialStateCost(sigma);
+Eigen::VectorXd WnoaTrajectory::InitialStateSigmas(const WnoaOptions& o) {
+  Eigen::VectorXd sigma(kStateSize);
+  sigma << o.initial_position_sigma, o.initial_position_sigma,
+      o.initial_heading_sigma, o.initial_velocity_sigma,
+      o.initial_velocity_sigma, o.initial_angular_velocity_sigma;
+  return sigma;
 }
 
-double WnoaTrajectory::InitialLogDet() const {
-  const WnoaOptions& o = options_;
-  // A sum of logs: the product of six sigmas leaves double's range first.
-  return -(2.0 * std::log(o.initial_position_sigma) +
-           std::log(o.initial_heading_sigma) +
-           2.0 * std::log(o.initial_velocity_sigma) +
-           std::log(o.initial_angular_velocity_sigma));
+Eigen::VectorXd WnoaTrajectory::InitialStateSigmas() const {
+  return InitialStateSigmas(options_);
+}
+
+ceres::CostFunction* WnoaTrajectory::NewInitialStateCost() const {
+  return new WnoaInitialStateCost(InitialStateSigmas());
 }
 
 double WnoaTrajectory::MotionLogDet(double dt) const {

@@ -80,6 +80,8 @@ class WnoaTrajectory : public StateTrajectory {
   // that into a prior cost of 10^5 and a solve that leaves its start.
   static std::vector<double> SmoothestVelocities(
       const std::vector<double>& times, const std::vector<double>& positions);
+  // The first state's prior sigmas, (p_x, p_y, p_theta, v_x, v_y, v_theta).
+  static Eigen::VectorXd InitialStateSigmas(const WnoaOptions& options);
 
  private:
   WnoaTrajectory(const WnoaOptions& options,
@@ -90,13 +92,14 @@ class WnoaTrajectory : public StateTrajectory {
   void PositionRows(double elapsed, double dt, double* lambda,
                     double* psi) const override;
   // SmoothestVelocities of the coordinate's positions.
-  void SetSmoothestDerivatives(int c) override;
+  void SetSmoothestDerivatives(int c,
+                               const std::vector<double>& positions) override;
+  Eigen::VectorXd InitialStateSigmas() const override;
   // WnoaInitialStateCost and WnoaPriorCost.
   ceres::CostFunction* NewInitialStateCost() const override;
   ceres::CostFunction* NewMotionCost(double dt) const override;
   void SetMotionQc(ceres::CostFunction* cost) const override;
   bool TakeScales(const StateTrajectory& rescaled) override;
-  double InitialLogDet() const override;
   double MotionLogDet(double dt) const override;
 
   WnoaOptions options_;

@@ -52,10 +52,9 @@ void WnojTrajectory::PositionWeights(double elapsed, double dt, double* lambda,
   psi[2] = dt * dt * 0.5 * (s3 - 2.0 * s4 + s5);
 }
 
-void WnojTrajectory::SetSmoothestDerivatives(int c) {
+void WnojTrajectory::SetSmoothestDerivatives(
+    int c, const std::vector<double>& positions) {
   const int n = num_blocks();
-  std::vector<double> positions(n);
-  for (int i = 0; i < n; ++i) positions[i] = block(i)[c];
   const std::vector<double> velocity =
       WnoaTrajectory::SmoothestVelocities(times_, positions);
   // e = r0 + J (a_k, a_k+1), r0 = (d - dt v_k, v_k+1 - v_k, 0), J = [-dt^2/2
@@ -63,13 +62,8 @@ void WnojTrajectory::SetSmoothestDerivatives(int c) {
   const std::vector<double> acceleration =
       SmoothestChain(n, [&](int k, Eigen::Matrix2d* h, Eigen::Vector2d* g) {
         const double dt = times_[k + 1] - times_[k];
-        const WnojPriorCost unit(dt, 1.0, 1.0, 1.0);
-        Eigen::Matrix3d w;
-        for (int row = 0; row < 3; ++row) {
-          for (int col = 0; col < 3; ++col) {
-            w(row, col) = unit.sqrt_information()(3 * row, 3 * col);
-          }
-        }
+        const Eigen::Matrix3d w =
+            WnojPriorCost::CoordinateSqrtInformation(dt, 1.0);
         Eigen::Matrix<double, 3, 2> jacobian;
         jacobian << -0.5 * dt * dt, 0.0, -dt, 0.0, -1.0, 1.0;
         const Eigen::Vector3d r0(
@@ -112,33 +106,26 @@ void WnojTrajectory::SetMotionQc(ceres::CostFunction* cost) const {
   }
 }
 
-ceres::CostFunction* WnojTrajectory::NewInitialStateCost() const {
-  const WnoaOptions& s = states_options_;
+Eigen::VectorXd WnojTrajectory::InitialStateSigmas() const {
   Eigen::VectorXd sigma(kStateSize);
-  sigma << s.initial_position_sigma, s.initial_position_sigma,
-      s.initial_heading_sigma, s.initial_velocity_sigma,
-      s.initial_velocity_sigma, s.initial_angular_velocity_sigma,
+  sigma << WnoaTrajectory::InitialStateSigmas(states_options_),
       options_.initial_acceleration_sigma, options_.initial_acceleration_sigma,
       options_.initial_angular_acceleration_sigma;
-  return new DiagonalPriorCost(Eigen::VectorXd::Zero(kStateSize), sigma);
+  return sigma;
 }
 
-double WnojTrajectory::InitialLogDet() const {
-  const WnojOptions& o = options_;
-  const WnoaOptions& s = states_options_;
-  // WNOA's six sigmas, then the accelerations', each as a log.
-  return -(2.0 * std::log(s.initial_position_sigma) +
-           std::log(s.initial_heading_sigma) +
-           2.0 * std::log(s.initial_velocity_sigma) +
-           std::log(s.initial_angular_velocity_sigma) +
-           2.0 * std::log(o.initial_acceleration_sigma) +
-           std::log(o.initial_angular_acceleration_sigma));
+ceres::CostFunction* WnojTrajectory::NewInitialStateCost() const {
+  return new DiagonalPriorCost(Eigen::VectorXd::Zero(kStateSize),
+                               InitialStateSigmas());
 }
 
 double WnojTrajectory::MotionLogDet(double dt) const {
-  // det S_c = det M / dt^(5 + 3 + 1)/2, det M = 2 sqrt(5) 4 sqrt(3) 3
-  // (wnoj_prior_cost.h).
-  return 3.0 * (std::log(24.0 * std::sqrt(15.0)) - 4.5 * std::log(dt));
+  // S_c is triangular: log det is the sum of its diagonal's logs.
+  return 3.0 * WnojPriorCost::CoordinateSqrtInformation(dt, 1.0)
+                   .diagonal()
+                   .array()
+                   .log()
+                   .sum();
 }
 
 ceres::CostFunction* WnojTrajectory::NewMotionCost(double dt) const {

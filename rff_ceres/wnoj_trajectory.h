@@ -79,13 +79,15 @@ class WnojTrajectory : public StateTrajectory {
   }
   // Velocities as WNOA's smoothest, then the accelerations that minimise
   // the WNOJ energy with positions and velocities held.
-  void SetSmoothestDerivatives(int c) override;
+  void SetSmoothestDerivatives(int c,
+                               const std::vector<double>& positions) override;
+  // WNOA's six sigmas, then the accelerations'.
+  Eigen::VectorXd InitialStateSigmas() const override;
   // A DiagonalPriorCost on the first state and WnojPriorCost.
   ceres::CostFunction* NewInitialStateCost() const override;
   ceres::CostFunction* NewMotionCost(double dt) const override;
   void SetMotionQc(ceres::CostFunction* cost) const override;
   bool TakeScales(const StateTrajectory& rescaled) override;
-  double InitialLogDet() const override;
   double MotionLogDet(double dt) const override;
 
   WnojOptions options_;
