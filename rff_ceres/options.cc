@@ -79,6 +79,15 @@ bool ValidateSlamOptions(const SlamOptions& options, std::string* error) {
                     "0 there");
     return false;
   }
+  if (incremental.every > 0 && options.learn_hyperparameters == "on") {
+    *error =
+        OptionError("learn_hyperparameters", "on",
+                    "learns from a solve of the whole run, which the "
+                    "incremental mode (--incremental_every=" +
+                        std::to_string(incremental.every) + ") does not do",
+                    "off or auto (off there)");
+    return false;
+  }
   // Every mean and pilot uses these, in the user's terms.
   if (!CheckLocalizationOptions(options.localization, error)) return false;
   for (const std::string& name : PriorNames()) {

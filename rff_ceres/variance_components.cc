@@ -1,11 +1,16 @@
 #include "rff_ceres/variance_components.h"
 
 #include <algorithm>
+#include <cmath>
+#include <map>
 #include <numeric>
 #include <random>
+#include <tuple>
+#include <utility>
 #include <vector>
 
 #include "ceres/crs_matrix.h"
+#include "ceres/loss_function.h"
 #include "glog/logging.h"
 #include "rff_ceres/banded_problem.h"
 #include "rff_ceres/gauss_newton_system.h"
@@ -207,7 +212,92 @@ bool SparseTraces(SlamProblem* problem, const std::vector<double*>& columns,
   return true;
 }
 
+// Below this share of their variance the fitted rows of a group are all
+// inliers (kappa over 0.98 for Cauchy's loss at 2 sigma on 3 rows), and
+// the probes' noise could take the redundancy to or below 0.
+constexpr double kMinRedundancyShare = 0.01;
+
+// Whether `loss` down-weights large residuals: rho'(s) < 1 far out. The
+// problem's "none" is a wrapper around no loss, rho(s) = s.
+bool IsRobust(const ceres::LossFunction* loss) {
+  if (loss == nullptr) return false;
+  double rho[3];
+  loss->Evaluate(1e8, rho);
+  return rho[1] < 1.0;
+}
+
+// Where the loss-corrected squares of rows under a robust loss were, each
+// row's rho'-weighted square over its Gaussian expectation at its group's
+// redundancy share (header). The rows are `ids`' in order.
+bool WeighRobustSquares(SlamProblem* problem,
+                        const std::vector<ceres::ResidualBlockId>& ids,
+                        const std::vector<VarianceGroup>& groups,
+                        const std::array<double, kNumVarianceGroups>& share,
+                        Eigen::VectorXd* squares, std::string* error) {
+  ceres::Problem& ceres_problem = *problem->problem();
+  std::map<std::tuple<const ceres::LossFunction*, int, VarianceGroup>, double>
+      consistency;
+  std::vector<double> residuals;
+  Eigen::Index row = 0;
+  for (const ceres::ResidualBlockId id : ids) {
+    const int k =
+        ceres_problem.GetCostFunctionForResidualBlock(id)->num_residuals();
+    const ceres::LossFunction* loss =
+        ceres_problem.GetLossFunctionForResidualBlock(id);
+    if (!IsRobust(loss)) {
+      row += k;
+      continue;
+    }
+    residuals.resize(k);
+    double cost = 0.0;
+    if (!ceres_problem.EvaluateResidualBlock(id, /*apply_loss_function=*/false,
+                                             &cost, residuals.data(),
+                                             nullptr)) {
+      *error = "the problem could not be evaluated";
+      return false;
+    }
+    double squared_norm = 0.0;
+    for (const double r : residuals) squared_norm += r * r;
+    double rho[3];
+    loss->Evaluate(squared_norm, rho);
+    for (const double r : residuals) {
+      const VarianceGroup group = groups[row];
+      auto [it, added] = consistency.try_emplace({loss, k, group}, 0.0);
+      if (added) {
+        it->second =
+            RobustConsistency(*loss, k, share[static_cast<int>(group)]);
+      }
+      (*squares)[row++] = rho[1] * r * r / it->second;
+    }
+  }
+  CHECK_EQ(row, squares->size());
+  return true;
+}
+
 }  // namespace
+
+double RobustConsistency(const ceres::LossFunction& loss, int k,
+                         double variance) {
+  // E[g(|z|^2)] over the chi density of |z|, z^(k-1) e^(-z^2/2) /
+  // (2^(k/2-1) Gamma(k/2)), by Simpson's rule out to where it is below 1e-30.
+  constexpr int kIntervals = 4000;
+  const double upper = std::sqrt(static_cast<double>(k)) + 12.0;
+  const double h = upper / kIntervals;
+  const double log_norm =
+      (0.5 * k - 1.0) * std::log(2.0) + std::lgamma(0.5 * k);
+  double sum = 0.0;
+  for (int i = 1; i <= kIntervals; ++i) {  // The integrand is 0 at z = 0.
+    const double z = i * h;
+    const double s = variance * z * z;
+    double rho[3];
+    loss.Evaluate(s, rho);
+    const double density =
+        std::exp((k - 1) * std::log(z) - 0.5 * z * z - log_norm);
+    const double weight = i == kIntervals ? 1.0 : (i % 2 == 1 ? 4.0 : 2.0);
+    sum += weight * rho[1] * s * density;
+  }
+  return sum * h / 3.0 / (k * variance);
+}
 
 bool EstimateVarianceComponents(SlamProblem* problem,
                                 const VarianceComponentOptions& options,
@@ -232,14 +322,26 @@ bool EstimateVarianceComponents(SlamProblem* problem,
                                error)) {
     return false;
   }
-  for (Eigen::Index r = 0; r < residuals.size(); ++r) {
-    VarianceComponent& c = (*components)[static_cast<int>(groups[r])];
-    ++c.rows;
-    c.sum_squares += residuals[r] * residuals[r];
+  for (const VarianceGroup group : groups) {
+    ++(*components)[static_cast<int>(group)].rows;
   }
+  std::array<double, kNumVarianceGroups> share{};
   for (int g = 0; g < kNumVarianceGroups; ++g) {
     VarianceComponent& c = (*components)[g];
     c.redundancy = c.rows - traces[g] / options.probes;
+    share[g] = c.rows > 0
+                   ? std::clamp(c.redundancy / c.rows, kMinRedundancyShare, 1.0)
+                   : 1.0;
+  }
+  Eigen::VectorXd squares = residuals.cwiseAbs2();
+  if (!WeighRobustSquares(problem, ids, groups, share, &squares, error)) {
+    return false;
+  }
+  for (Eigen::Index r = 0; r < squares.size(); ++r) {
+    (*components)[static_cast<int>(groups[r])].sum_squares += squares[r];
+  }
+  for (int g = 0; g < kNumVarianceGroups; ++g) {
+    VarianceComponent& c = (*components)[g];
     if (g != static_cast<int>(VarianceGroup::kFixed) &&
         c.redundancy >= options.min_redundancy) {
       c.factor = c.sum_squares / c.redundancy;

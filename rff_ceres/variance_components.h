@@ -8,12 +8,18 @@
 //
 // the denominator being the group's redundancy: its rows less the share of
 // the parameters they determine (Foerstner 1979; Koch 1999, 3.6; for the
-// prior's scale it is MacKay's 1992 fixed point gamma). Iterating solve and
-// rescale maximises the Laplace evidence over the scales. The traces come
-// from Hutchinson's estimator tr(A) = E[z^T A z] with seeded Rademacher
-// probes and one solve each: for banded states in the time-ordered
-// envelope BANDED_CHOLESKY factorises, J z term by term; else through the
-// sparse Jacobian.
+// prior's scale it is MacKay's 1992 fixed point gamma). Under a robust loss
+// rho a row's r_i^2 becomes rho'(|r_b|^2) r_i^2 / kappa over its block r_b
+// of k rows, kappa = E[rho'(v |z|^2) |z|^2] / k for z ~ N(0, I_k) and v its
+// group's redundancy over its rows (a fitted row's share of its variance):
+// Gaussian rows then give s_g = 1 at their own sigma (Huber 1964, Proposal
+// 2), where the loss-corrected squares, rho' r^2, fall short by kappa
+// (Cauchy at 2 sigma on 3 free rows: 0.49) and the rounds ran down by it.
+// Iterating solve and rescale maximises the Laplace evidence over the
+// scales. The traces come from Hutchinson's estimator tr(A) = E[z^T A z] with
+// seeded Rademacher probes and one solve each: for banded states in the
+// time-ordered envelope BANDED_CHOLESKY factorises, J z term by term; else
+// through the sparse Jacobian.
 #ifndef RFF_CERES_VARIANCE_COMPONENTS_H_
 #define RFF_CERES_VARIANCE_COMPONENTS_H_
 
@@ -22,6 +28,7 @@
 #include <vector>
 
 #include "Eigen/SparseCore"
+#include "ceres/loss_function.h"
 #include "ceres/problem.h"
 #include "rff_ceres/gauss_newton_system.h"
 #include "rff_ceres/slam_problem.h"
@@ -101,6 +108,11 @@ bool Linearize(ceres::Problem* problem,
                Eigen::VectorXd* residuals,
                Eigen::SparseMatrix<double, Eigen::RowMajor>* jacobian,
                std::string* error, const std::vector<double*>& columns = {});
+
+// kappa above, for a block of k rows under `loss` whose residuals have
+// `variance` (in (0, 1]) of a row's: 1 without a loss.
+double RobustConsistency(const ceres::LossFunction& loss, int k,
+                         double variance = 1.0);
 
 // "range", "bearing", "odometry", "trajectory position", ... for reports.
 const char* VarianceGroupName(VarianceGroup group);

@@ -1180,7 +1180,9 @@ TEST(SlamSolverTest, AutoLossIsDroppedOnlyWhereNoResidualIsAnOutlier) {
   EXPECT_EQ(robust.odometry_loss, "cauchy");
 }
 
-TEST(SlamSolverTest, IncrementalModeRejectsOuterRounds) {
+// What needs the whole run solved at once: refitting the mean to it, and
+// learning from it.
+TEST(SlamSolverTest, IncrementalModeRejectsWholeRunOptions) {
   SimulationOptions sim = PaperOptions(15);
   sim.num_steps = 20;
   Dataset dataset;
@@ -1194,6 +1196,13 @@ TEST(SlamSolverTest, IncrementalModeRejectsOuterRounds) {
   EXPECT_EQ(error,
             "--outer_rounds=1: refits the whole run, which the incremental "
             "mode (--incremental_every=5) does not do; allowed 0 there");
+  options.mean.outer_rounds = 0;
+  options.learn_hyperparameters = "on";
+  EXPECT_FALSE(RunSlam(dataset, options, &result, &error));
+  EXPECT_EQ(error,
+            "--learn_hyperparameters=on: learns from a solve of the whole "
+            "run, which the incremental mode (--incremental_every=5) does not "
+            "do; allowed off or auto (off there)");
 }
 
 TEST(SlamSolverTest, OneThreadIsBitReproducibleAndTwoAgreeToRounding) {
