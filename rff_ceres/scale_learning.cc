@@ -207,8 +207,8 @@ bool LearnScales(const Dataset& dataset,
   };
   note_radius();
   // The evidence is the Gaussian rows' (LaplaceLogEvidence). Under a robust
-  // loss the rounds rescale the loss-corrected residuals, whose fixed point
-  // is no stationary point of it: it guards nothing there.
+  // loss the rounds rescale the loss-weighted squares, whose fixed point is
+  // no stationary point of it: it guards nothing there.
   const bool odometry_rows =
       settled->problem.use_odometry && !dataset.odometry.empty();
   const bool gaussian =
