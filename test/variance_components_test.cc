@@ -276,7 +276,7 @@ TEST(VarianceComponentsTest,
 }
 
 // Sigmas stated ten times too tight make the default losses Cauchy's.
-// The rounds then rescale loss-corrected residuals, which do not climb the
+// The rounds then rescale loss-weighted squares, which do not climb the
 // Gaussian rows' evidence, so no evidence is kept and none ends the rounds:
 // the sigmas rise to the drawn ones. Measured: range 9.7, bearing 10.3
 // after 9 rounds (5.2 and 5.6 when the rounds rescaled the loss-corrected
