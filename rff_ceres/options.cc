@@ -85,7 +85,7 @@ bool ValidateSlamOptions(const SlamOptions& options, std::string* error) {
                     "learns from a solve of the whole run, which the "
                     "incremental mode (--incremental_every=" +
                         std::to_string(incremental.every) + ") does not do",
-                    "off or auto (off there)");
+                    "off or auto");
     return false;
   }
   // Every mean and pilot uses these, in the user's terms.

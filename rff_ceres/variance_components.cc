@@ -228,7 +228,9 @@ bool IsRobust(const ceres::LossFunction* loss) {
 
 // Where the loss-corrected squares of rows under a robust loss were, each
 // row's rho'-weighted square over its Gaussian expectation at its group's
-// redundancy share (header). The rows are `ids`' in order.
+// redundancy share (header). The rows are `ids`' in order. One share per
+// group: rows of unequal leverage, and a block whose rows belong to two
+// groups, are weighed as if all had it.
 bool WeighRobustSquares(SlamProblem* problem,
                         const std::vector<ceres::ResidualBlockId>& ids,
                         const std::vector<VarianceGroup>& groups,

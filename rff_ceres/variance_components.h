@@ -12,9 +12,12 @@
 // rho a row's r_i^2 becomes rho'(|r_b|^2) r_i^2 / kappa over its block r_b
 // of k rows, kappa = E[rho'(v |z|^2) |z|^2] / k for z ~ N(0, I_k) and v its
 // group's redundancy over its rows (a fitted row's share of its variance):
-// Gaussian rows then give s_g = 1 at their own sigma (Huber 1964, Proposal
-// 2), where the loss-corrected squares, rho' r^2, fall short by kappa
-// (Cauchy at 2 sigma on 3 free rows: 0.49) and the rounds ran down by it.
+// the squares the IRLS weights rho' give, made consistent so that Gaussian
+// rows give s_g = 1 at their own sigma. Unscaled (the loss-corrected
+// squares) they fall short by kappa (Cauchy at 2 sigma on 3 free rows:
+// 0.49), and the rounds ran down by it. Not Huber's Proposal 2 (psi^2 =
+// rho'^2 r^2): under a redescending loss its sigma collapses (MRCLAM's
+// odometry went to zero).
 // Iterating solve and rescale maximises the Laplace evidence over the
 // scales. The traces come from Hutchinson's estimator tr(A) = E[z^T A z] with
 // seeded Rademacher probes and one solve each: for banded states in the

@@ -1202,7 +1202,7 @@ TEST(SlamSolverTest, IncrementalModeRejectsWholeRunOptions) {
   EXPECT_EQ(error,
             "--learn_hyperparameters=on: learns from a solve of the whole "
             "run, which the incremental mode (--incremental_every=5) does not "
-            "do; allowed off or auto (off there)");
+            "do; allowed off or auto");
 }
 
 TEST(SlamSolverTest, OneThreadIsBitReproducibleAndTwoAgreeToRounding) {
