@@ -263,6 +263,8 @@ bool LearnScales(const Dataset& dataset,
   face_value.range_calibration.estimate = false;
   face_value.odometry_calibration.estimate = false;
   const double face_value_information = ScaleInformation(dataset, face_value);
+  // Whether any round had enough of the prior's rows to estimate its scale.
+  bool prior_estimated = false;
   int rounds_cap = kMaxScaleRounds;
   for (int round = 0; round < rounds_cap; ++round) {
     VarianceComponents components;
@@ -310,6 +312,7 @@ bool LearnScales(const Dataset& dataset,
     // `power` 1 for a variance, 0.5 for a sigma.
     auto rescale = [&](VarianceGroup group, double power, double* scale) {
       const VarianceComponent& c = components[static_cast<int>(group)];
+      if (power == 1.0 && c.estimated) prior_estimated = true;
       if (!c.estimated || kept.count(group) > 0 || at_boundary.count(group) ||
           (power == 1.0 && !prior_scales_learned)) {
         return;
@@ -465,6 +468,14 @@ bool LearnScales(const Dataset& dataset,
       return false;
     }
     note_radius();
+  }
+  if (!prior_estimated && result->prior_scales_kept.empty() &&
+      result->scales_not_learned.empty()) {
+    std::ostringstream why;
+    why << "the data leave its rows under "
+        << VarianceComponentOptions().min_redundancy
+        << " of redundancy (rows less the parameters they determine)";
+    result->prior_scales_kept = why.str();
   }
   const bool capped = result->learning_rounds == rounds_cap &&
                       !result->learning_converged &&

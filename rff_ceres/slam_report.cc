@@ -76,8 +76,9 @@ void PrintSlamSummary(const SlamOptions& options, const SlamResult& result,
     } else {
       // A feature prior's rounds learn no noise: its mean's solve did.
       *out << " kept as given: " << result.prior_scales_kept
-           << (prior.has_features()
-                   ? ", "
+           << (prior.has_features() ? ", "
+               : result.noise_learned.empty()
+                   ? "; no noise factor learned either, "
                    : "; the noise factors learned by variance components, ");
     }
     *out << result.learning_rounds

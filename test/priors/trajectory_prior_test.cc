@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "gtest/gtest.h"
+#include "rff_ceres/io/dataset_io.h"
 #include "rff_ceres/mean/mean_function.h"
 #include "rff_ceres/slam_report.h"
 #include "rff_ceres/slam_solver.h"
@@ -150,6 +151,37 @@ TEST(TrajectoryPriorTest, ScalesLineOfRoundsThatStoppedShort) {
                               "factors still moving)"),
             std::string::npos)
       << capped.str();
+}
+
+// Sightings at one time leave a Markov prior no rows to learn its Q_c
+// from (nor the noise theirs): the scales line says it kept them, not that
+// it learned them.
+TEST(TrajectoryPriorTest, ScalesLineOfDataThatLeaveNothingToLearn) {
+  std::istringstream text(
+      "RFFD 1\n"
+      "PRIOR_POSE 0 0 0 0 0.1 0.05\n"
+      "PRIOR_LANDMARK 1 5 0 1\n"
+      "PRIOR_LANDMARK 2 0 5 1\n"
+      "RANGE_BEARING 0 1 5.1 0.02 0.1 0.02\n"
+      "RANGE_BEARING 0 2 4.9 1.55 0.1 0.02\n");
+  Dataset dataset;
+  std::string error;
+  ASSERT_TRUE(ParseDataset(&text, "one time", &dataset, &error)) << error;
+  for (const char* name : {"wnoa", "wnoj"}) {
+    SlamOptions options;
+    options.prior = name;
+    SlamResult result;
+    ASSERT_TRUE(RunSlam(dataset, options, &result, &error)) << error;
+    std::ostringstream out;
+    PrintSlamSummary(options, result, &out);
+    EXPECT_NE(out.str().find("  scales       Q_c kept as given: the data "
+                             "leave its rows under 10 of redundancy (rows "
+                             "less the parameters they determine); no noise "
+                             "factor learned either, 1 round\n"),
+              std::string::npos)
+        << name << "\n"
+        << out.str();
+  }
 }
 
 }  // namespace
