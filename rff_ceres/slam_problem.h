@@ -230,6 +230,10 @@ class SlamProblem {
   // ill-conditioned (condition number above `max_condition`): its estimate
   // would be noise.
   bool FindNonFinite(std::string* description);
+  // The block's whitened residuals without its robust loss; false where
+  // Ceres cannot evaluate it (a non-finite residual).
+  bool EvaluateWithoutLoss(ceres::ResidualBlockId id,
+                           std::vector<double>* residuals);
   // The whitened residuals (without the robust loss) at the current values,
   // grouped by what they are: "range", "bearing", "range-bearing",
   // "odometry", "landmark prior", "pose prior", "range calibration prior"
@@ -335,10 +339,6 @@ class SlamProblem {
   };
   bool EvaluateVariableBlocks(ceres::ResidualBlockId id, bool apply_loss,
                               BlockEvaluation* evaluation);
-  // The block's whitened residuals without its robust loss; false where
-  // Ceres cannot evaluate it (a non-finite residual).
-  bool EvaluateWithoutLoss(ceres::ResidualBlockId id,
-                           std::vector<double>* residuals);
   // A calibration block `values` under the prior N(mean, diag(sigma^2)) (a
   // residual of kind `kind`, a literal), held within [lower, upper].
   void AddCalibration(const char* kind, const Eigen::Vector2d& mean,

@@ -250,11 +250,7 @@ bool WeighRobustSquares(SlamProblem* problem,
       row += k;
       continue;
     }
-    residuals.resize(k);
-    double cost = 0.0;
-    if (!ceres_problem.EvaluateResidualBlock(id, /*apply_loss_function=*/false,
-                                             &cost, residuals.data(),
-                                             nullptr)) {
+    if (!problem->EvaluateWithoutLoss(id, &residuals)) {
       *error = "the problem could not be evaluated";
       return false;
     }
