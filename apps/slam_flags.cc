@@ -113,6 +113,10 @@ DEFINE_double(wnoa_initial_angular_velocity_sigma, 1.0,
               "WNOA and WNOJ: prior sigma of the first state's angular "
               "velocity "
               "(rad/s), more than 0.");
+DEFINE_string(wnoa_qc_start, "odometry",
+              "WNOA: where learning starts Q_c: odometry (the diffusion the "
+              "dead reckoning's second differences imply, where the run has "
+              "odometry) or given (--wnoa_position_qc, --wnoa_heading_qc).");
 DEFINE_double(wnoa_min_state_spacing, 0.0,
               "WNOA: merge states closer than this (seconds), 0 or more; 0 "
               "keeps one per observation time.");
@@ -268,6 +272,7 @@ SlamOptions SlamOptionsFromFlags() {
   w.initial_velocity_sigma = FLAGS_wnoa_initial_velocity_sigma;
   w.initial_angular_velocity_sigma = FLAGS_wnoa_initial_angular_velocity_sigma;
   w.min_state_spacing = FLAGS_wnoa_min_state_spacing;
+  w.qc_start = FLAGS_wnoa_qc_start;
   WnojOptions& j = options.wnoj;
   j.position_qc = FLAGS_wnoj_position_qc;
   j.heading_qc = FLAGS_wnoj_heading_qc;

@@ -62,6 +62,22 @@ std::string DriftJson(const std::vector<ResidualDrift>& drifts) {
   return out + "]";
 }
 
+// What Q_c the learning went back to where it kept the prior's scales.
+const char* KeptAs(const SlamResult& result) {
+  return result.qc_from_odometry.windows > 0 ? " kept at the odometry's: "
+                                             : " kept as given: ";
+}
+
+// The Q_c the WNOA rounds started from, or null where not the odometry's.
+std::string QcFromOdometryJson(const SlamResult& result) {
+  const OdometryDiffusion& d = result.qc_from_odometry;
+  if (d.windows == 0) return "null";
+  return "{\"position\": " + FormatNumber(d.position_qc) +
+         ", \"heading\": " + FormatNumber(d.heading_qc) +
+         ", \"window_seconds\": " + FormatNumber(d.window_seconds) +
+         ", \"windows\": " + std::to_string(d.windows) + "}";
+}
+
 }  // namespace
 
 void PrintSlamSummary(const SlamOptions& options, const SlamResult& result,
@@ -75,7 +91,7 @@ void PrintSlamSummary(const SlamOptions& options, const SlamResult& result,
       *out << " learned by variance components, ";
     } else {
       // A feature prior's rounds learn no noise: its mean's solve did.
-      *out << " kept as given: " << result.prior_scales_kept
+      *out << KeptAs(result) << result.prior_scales_kept
            << (prior.has_features() ? ", "
                : result.noise_learned.empty()
                    ? "; no noise factor learned either, "
@@ -89,6 +105,12 @@ void PrintSlamSummary(const SlamOptions& options, const SlamResult& result,
              : !result.scales_not_learned.empty()
                  ? " (stopped short: see the warning)"
                  : " (stopped at the round cap, the factors still moving)");
+    const OdometryDiffusion& odometry = result.qc_from_odometry;
+    if (odometry.windows > 0 && result.prior_scales_kept.empty() &&
+        !prior.has_features()) {
+      *out << "; from the odometry's " << odometry.position_qc << " (x, y), "
+           << odometry.heading_qc << " (theta)";
+    }
     const char* separator = "; at zero, the data leave no variance to: ";
     for (const std::string& group : result.scales_at_boundary) {
       *out << separator << group;
@@ -171,7 +193,7 @@ void PrintSlamSummary(const SlamOptions& options, const SlamResult& result,
          << result.start_heading.prior_heading << ")";
   }
   if (!result.start_prior_scales_kept.empty()) {
-    *out << "; its Q_c kept as given: " << result.start_prior_scales_kept;
+    *out << "; its Q_c" << KeptAs(result) << result.start_prior_scales_kept;
   }
   *out << "\n";
   const bool depth = result.range_bearing_ranges == "depth";
@@ -290,6 +312,7 @@ void WriteSummaryJson(const SlamOptions& options, const SlamResult& result,
       << ",\n"
       << "  \"start_prior_scales_kept\": "
       << JsonString(result.start_prior_scales_kept) << ",\n"
+      << "  \"qc_from_odometry\": " << QcFromOdometryJson(result) << ",\n"
       << "  \"prior_scale_factors\": ["
       << FormatNumber(result.prior_scale_factors[0]) << ", "
       << FormatNumber(result.prior_scale_factors[1]) << "],\n"

@@ -295,14 +295,22 @@ bool ReportSolution(const Dataset& dataset, const SlamOptions& options,
   return true;
 }
 
-bool RunSlamAtOrigin(const Dataset& dataset, const SlamOptions& options,
+bool RunSlamAtOrigin(const Dataset& dataset, const SlamOptions& given,
                      SlamResult* result, std::string* error) {
   const auto start = std::chrono::steady_clock::now();
   *result = SlamResult();
   ceres::Solver::Options ceres_options;
-  if (!ToCeresOptions(options.solver, &ceres_options, error)) return false;
-  if (!ValidateSlamOptions(options, error)) return false;
-  if (!CheckData(dataset, options, error)) return false;
+  if (!ToCeresOptions(given.solver, &ceres_options, error)) return false;
+  if (!ValidateSlamOptions(given, error)) return false;
+  if (!CheckData(dataset, given, error)) return false;
+  // A Markov prior's learning rounds (batch solves only) start where the
+  // data put its scales.
+  SlamOptions options = given;
+  if (!PriorOf(options).has_features() &&
+      options.learn_hyperparameters != "off" &&
+      options.incremental.every == 0) {
+    PriorOf(options).StartLearnedScales(dataset, &options, result);
+  }
   const IncrementalOptions& incremental = options.incremental;
 
   // The start (heading, pilot) may come from the data.

@@ -19,6 +19,7 @@
 #include "rff_ceres/hyperparameter_learning.h"
 #include "rff_ceres/initialization.h"
 #include "rff_ceres/options.h"
+#include "rff_ceres/priors/odometry_diffusion.h"
 #include "rff_ceres/quality_report.h"
 #include "rff_ceres/range_reading.h"
 #include "rff_ceres/residual_drift.h"
@@ -102,6 +103,9 @@ struct SlamResult {
   std::string prior_scales_kept;
   // The same for the WNOA solve a feature prior's solve started from.
   std::string start_prior_scales_kept;
+  // The Q_c the WNOA learning rounds started from, where the odometry gave
+  // it (windows > 0; TrajectoryPrior::StartLearnedScales).
+  OdometryDiffusion qc_from_odometry;
   Eigen::Vector2d prior_scale_factors = Eigen::Vector2d::Ones();
   // The factors on the data's sigmas the solve ended with: learned with the
   // WNOA prior's scales (and passed on to an RFF solve about it), else 1.

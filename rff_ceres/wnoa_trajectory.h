@@ -52,6 +52,10 @@ struct WnoaOptions {
   // States closer than this in time are merged into one (seconds, >= 0);
   // 0 keeps a state at every distinct requested time.
   double min_state_spacing = 0.0;
+  // Where the learning rounds start Q_c: "odometry", the diffusion the
+  // dead reckoning implies (priors/odometry_diffusion.h) where the run has
+  // odometry, else the values above; "given", the values above.
+  std::string qc_start = "odometry";
 };
 
 class WnoaTrajectory : public StateTrajectory {

@@ -55,6 +55,13 @@ class TrajectoryPrior {
   // learning keeps them.
   virtual std::vector<std::string> scale_flags() const = 0;
 
+  // Moves the scales the learning rounds start from (PositionScale,
+  // HeadingScale) to what `dataset` implies before any solve, and records
+  // it in `result`; the given ones by default.
+  virtual void StartLearnedScales(const Dataset& /*dataset*/,
+                                  SlamOptions* /*options*/,
+                                  SlamResult* /*result*/) const {}
+
   // Copies into `result` what the model settled when it was built (a
   // feature count the capacity rule chose); nothing by default.
   virtual void RecordModel(const TrajectoryModel& /*model*/,

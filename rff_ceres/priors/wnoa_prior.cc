@@ -5,6 +5,8 @@
 #include <utility>
 #include <vector>
 
+#include "rff_ceres/option_error.h"
+#include "rff_ceres/priors/odometry_diffusion.h"
 #include "rff_ceres/priors/trajectory_prior.h"
 #include "rff_ceres/slam_problem.h"
 #include "rff_ceres/wnoa_trajectory.h"
@@ -35,6 +37,10 @@ class WnoaPriorImpl : public TrajectoryPrior {
 
   bool CheckOptions(const SlamOptions& options,
                     std::string* error) const override {
+    if (!CheckOneOf(options.wnoa.qc_start, "wnoa_qc_start", "",
+                    {"odometry", "given"}, error)) {
+      return false;
+    }
     return WnoaTrajectory::Create(options.wnoa, UnitWindowMean(), {0.0},
                                   error) != nullptr;
   }
@@ -56,6 +62,24 @@ class WnoaPriorImpl : public TrajectoryPrior {
   }
   double* HeadingScale(SlamOptions* options) const override {
     return &options->wnoa.heading_qc;
+  }
+  // A Q_c from the motion itself: the default 1 m^2/s^3 is 36 (Plaza) to
+  // 25000 (MRCLAM) times what recordings learn, tenfold steps a round away.
+  void StartLearnedScales(const Dataset& dataset, SlamOptions* options,
+                          SlamResult* result) const override {
+    // An odometry whose scale is estimated says nothing of the motion's
+    // size (the scale absorbs it): Q_c learned from such a start shrank the
+    // map with the scale.
+    OdometryDiffusion diffusion;
+    if (options->wnoa.qc_start != "odometry" ||
+        !options->problem.use_odometry ||
+        options->problem.odometry_calibration.estimate ||
+        !EstimateOdometryDiffusion(dataset.odometry, &diffusion)) {
+      return;
+    }
+    options->wnoa.position_qc = diffusion.position_qc;
+    options->wnoa.heading_qc = diffusion.heading_qc;
+    result->qc_from_odometry = diffusion;
   }
   const char* scales_name() const override { return "Q_c"; }
   std::vector<std::string> scale_flags() const override {

@@ -7,6 +7,7 @@
 #include "gtest/gtest.h"
 #include "rff_ceres/io/dataset_io.h"
 #include "rff_ceres/mean/mean_function.h"
+#include "rff_ceres/simulate.h"
 #include "rff_ceres/slam_report.h"
 #include "rff_ceres/slam_solver.h"
 
@@ -182,6 +183,48 @@ TEST(TrajectoryPriorTest, ScalesLineOfDataThatLeaveNothingToLearn) {
         << name << "\n"
         << out.str();
   }
+}
+
+// The default Q_c (1 m^2/s^3) is about 50 times what a 10 Hz wheel run
+// learns; started from its odometry's second differences the rounds need
+// fewer steps to the same place.
+TEST(TrajectoryPriorTest, WnoaLearningStartsFromTheOdometry) {
+  SimulationOptions sim = Laser10HzOptions(11);
+  sim.num_steps = 1500;
+  Dataset dataset;
+  std::string error;
+  ASSERT_TRUE(Simulate(sim, &dataset, &error)) << error;
+  SlamOptions options;
+  options.prior = "wnoa";
+  SlamResult started, given;
+  ASSERT_TRUE(RunSlam(dataset, options, &started, &error)) << error;
+  options.wnoa.qc_start = "given";
+  ASSERT_TRUE(RunSlam(dataset, options, &given, &error)) << error;
+  EXPECT_EQ(given.qc_from_odometry.windows, 0);
+  EXPECT_EQ(started.qc_from_odometry.windows, 298);  // 149.9 s of records.
+  const double start = started.qc_from_odometry.position_qc;
+  const double learned = given.wnoa_options.position_qc;
+  // Within a factor 2 (its noise adds to the second differences), where the
+  // default is 1 / learned = 50 times off.
+  EXPECT_GT(start / learned, 1.0);
+  EXPECT_LT(start / learned, 2.0);
+  EXPECT_GT(1.0 / learned, 40.0);
+  EXPECT_LE(started.learning_rounds + 3, given.learning_rounds);
+  // Each stops once a round moves its scales by under 10%, from its side.
+  EXPECT_NEAR(started.wnoa_options.position_qc / learned, 1.0, 0.2);
+  EXPECT_NEAR(started.wnoa_options.heading_qc / given.wnoa_options.heading_qc,
+              1.0, 0.2);
+  std::ostringstream out;
+  options.wnoa.qc_start = "odometry";
+  PrintSlamSummary(options, started, &out);
+  std::ostringstream expected;
+  expected << "Q_c learned by variance components, " << started.learning_rounds
+           << " rounds; from the odometry's " << start << " (x, y), "
+           << started.qc_from_odometry.heading_qc << " (theta)\n";
+  EXPECT_NE(out.str().find(expected.str()), std::string::npos) << out.str();
+  options.wnoa.qc_start = "dead reckoning";
+  EXPECT_FALSE(RunSlam(dataset, options, &started, &error));
+  EXPECT_EQ(error, "--wnoa_qc_start=dead reckoning: allowed odometry or given");
 }
 
 }  // namespace
