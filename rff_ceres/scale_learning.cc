@@ -224,7 +224,10 @@ bool LearnScales(const Dataset& dataset,
     double log_evidence = 0.0;
   };
   Solved last;
-  bool climbed = false;
+  // A Q_c started from the odometry is near its fixed point: a fall is a
+  // sign from the first round on. From the given value the first rounds may
+  // fall on their way (docs/uncertainty.md).
+  bool climbed = !prior.has_features() && result->qc_from_odometry.windows > 0;
   // Scaling the positions about the start by 1 + s scales the position
   // prior's whitened rows; at Q_c's fixed point their squares sum to the
   // group's redundancy R, the prior's pull on s^2. With the data's I the
@@ -299,7 +302,8 @@ bool LearnScales(const Dataset& dataset,
     // before solved with, and the final solve.
     const double rounding =
         kEvidenceRounding * std::max(1.0, std::abs(last.log_evidence));
-    bool evidence_fell = gaussian && climbed && !prior_scales_reset &&
+    bool evidence_fell = gaussian && climbed && round > 0 &&
+                         !prior_scales_reset &&
                          solved.log_evidence < last.log_evidence - rounding;
     climbed = climbed || (round > 0 && solved.log_evidence > last.log_evidence);
     double largest_step = 0.0;

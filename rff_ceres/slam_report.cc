@@ -62,10 +62,11 @@ std::string DriftJson(const std::vector<ResidualDrift>& drifts) {
   return out + "]";
 }
 
-// What Q_c the learning went back to where it kept the prior's scales.
-const char* KeptAs(const SlamResult& result) {
-  return result.qc_from_odometry.windows > 0 ? " kept at the odometry's: "
-                                             : " kept as given: ";
+// What a Markov prior's learning went back to where it kept its Q_c.
+const char* KeptAs(const SlamResult& result, bool markov) {
+  return markov && result.qc_from_odometry.windows > 0
+             ? " kept at the odometry's: "
+             : " kept as given: ";
 }
 
 // The Q_c the WNOA rounds started from, or null where not the odometry's.
@@ -91,7 +92,7 @@ void PrintSlamSummary(const SlamOptions& options, const SlamResult& result,
       *out << " learned by variance components, ";
     } else {
       // A feature prior's rounds learn no noise: its mean's solve did.
-      *out << KeptAs(result) << result.prior_scales_kept
+      *out << KeptAs(result, !prior.has_features()) << result.prior_scales_kept
            << (prior.has_features() ? ", "
                : result.noise_learned.empty()
                    ? "; no noise factor learned either, "
@@ -106,10 +107,13 @@ void PrintSlamSummary(const SlamOptions& options, const SlamResult& result,
                  ? " (stopped short: see the warning)"
                  : " (stopped at the round cap, the factors still moving)");
     const OdometryDiffusion& odometry = result.qc_from_odometry;
-    if (odometry.windows > 0 && result.prior_scales_kept.empty() &&
-        !prior.has_features()) {
+    if (prior.has_features()) {
+      // The WNOA mean's start is its own solve's.
+    } else if (odometry.windows > 0 && result.prior_scales_kept.empty()) {
       *out << "; from the odometry's " << odometry.position_qc << " (x, y), "
            << odometry.heading_qc << " (theta)";
+    } else if (!result.qc_start_kept.empty()) {
+      *out << "; started as given: " << result.qc_start_kept;
     }
     const char* separator = "; at zero, the data leave no variance to: ";
     for (const std::string& group : result.scales_at_boundary) {
@@ -193,7 +197,8 @@ void PrintSlamSummary(const SlamOptions& options, const SlamResult& result,
          << result.start_heading.prior_heading << ")";
   }
   if (!result.start_prior_scales_kept.empty()) {
-    *out << "; its Q_c" << KeptAs(result) << result.start_prior_scales_kept;
+    *out << "; its Q_c" << KeptAs(result, /*markov=*/true)
+         << result.start_prior_scales_kept;
   }
   *out << "\n";
   const bool depth = result.range_bearing_ranges == "depth";
@@ -313,6 +318,7 @@ void WriteSummaryJson(const SlamOptions& options, const SlamResult& result,
       << "  \"start_prior_scales_kept\": "
       << JsonString(result.start_prior_scales_kept) << ",\n"
       << "  \"qc_from_odometry\": " << QcFromOdometryJson(result) << ",\n"
+      << "  \"qc_start_kept\": " << JsonString(result.qc_start_kept) << ",\n"
       << "  \"prior_scale_factors\": ["
       << FormatNumber(result.prior_scale_factors[0]) << ", "
       << FormatNumber(result.prior_scale_factors[1]) << "],\n"

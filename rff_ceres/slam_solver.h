@@ -104,8 +104,10 @@ struct SlamResult {
   // The same for the WNOA solve a feature prior's solve started from.
   std::string start_prior_scales_kept;
   // The Q_c the WNOA learning rounds started from, where the odometry gave
-  // it (windows > 0; TrajectoryPrior::StartLearnedScales).
+  // it (windows > 0; TrajectoryPrior::StartLearnedScales), else why the
+  // odometry's was not taken (empty without odometry or where not asked).
   OdometryDiffusion qc_from_odometry;
+  std::string qc_start_kept;
   Eigen::Vector2d prior_scale_factors = Eigen::Vector2d::Ones();
   // The factors on the data's sigmas the solve ended with: learned with the
   // WNOA prior's scales (and passed on to an RFF solve about it), else 1.

@@ -121,6 +121,7 @@ std::shared_ptr<const MeanFunction> BuildMean(
       warm->start.landmarks[l.id] = Eigen::Vector2d(l.x, l.y);
     }
     result->qc_from_odometry = wnoa.qc_from_odometry;
+    result->qc_start_kept = wnoa.qc_start_kept;
     if (wnoa_mean) {
       // Its Q_c is the mean's; a start only leaves the prior its own.
       result->prior_scales_kept = wnoa.prior_scales_kept;

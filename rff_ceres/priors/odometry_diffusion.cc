@@ -2,19 +2,21 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "costs/angle.h"
 #include "rff_ceres/dead_reckoning.h"
+#include "rff_ceres/metrics.h"
 
 namespace rff {
 namespace {
 
 constexpr double kMinWindowSeconds = 0.5;
 constexpr int kMinWindows = 10;
-constexpr double kWindowsPerRecord = 4.0;
+constexpr double kMinShare = 0.5;
 
 // The chain's pose at t by linear interpolation of its nodes, heading
 // unwound (`nodes` sorted, t inside their span).
@@ -35,27 +37,52 @@ Eigen::Vector3d PoseAt(const std::vector<TimedPose>& nodes,
 
 }  // namespace
 
-bool EstimateOdometryDiffusion(const std::vector<Odometry>& odometry,
-                               OdometryDiffusion* diffusion) {
+bool EstimateOdometryDiffusion(std::vector<Odometry> odometry,
+                               OdometryDiffusion* diffusion, std::string* why) {
   *diffusion = OdometryDiffusion();
-  if (odometry.empty()) return false;
-  std::vector<double> durations;
-  double first = odometry.front().t0;
-  for (const Odometry& o : odometry) {
-    durations.push_back(o.t1 - o.t0);
-    first = std::min(first, o.t0);
+  if (odometry.empty()) {
+    *why = "the run has no odometry";
+    return false;
   }
+  std::sort(odometry.begin(), odometry.end(),
+            [](const Odometry& a, const Odometry& b) { return a.t0 < b.t0; });
+  std::vector<double> durations;
+  for (const Odometry& o : odometry) durations.push_back(o.t1 - o.t0);
   std::nth_element(durations.begin(), durations.begin() + durations.size() / 2,
                    durations.end());
-  const double median = durations[durations.size() / 2];
+  const double w = std::max(kMinWindowSeconds, durations[durations.size() / 2]);
+  // Stretches of records no longer than a window, meeting end to end: a
+  // longer record is a straight line whose second differences are zero, and
+  // a gap holds the pose.
+  std::vector<std::pair<double, double>> stretches;
+  double recorded = 0.0, in_stretches = 0.0;
+  for (const Odometry& o : odometry) {
+    recorded += o.t1 - o.t0;
+    if (o.t1 - o.t0 <= w) in_stretches += o.t1 - o.t0;
+    const bool short_record = o.t1 - o.t0 <= w;
+    const bool meets =
+        !stretches.empty() &&
+        std::abs(o.t0 - stretches.back().second) <= kTimeToleranceSeconds;
+    if (short_record && meets) {
+      stretches.back().second = o.t1;
+    } else if (short_record) {
+      stretches.push_back({o.t0, o.t1});
+    }
+  }
+  std::ostringstream out;
+  if (in_stretches < kMinShare * recorded) {
+    // Then the estimate would describe the motion of a minority of the run.
+    out << "the odometry's records no longer than " << w << " s cover "
+        << in_stretches / recorded << " of its time, under " << kMinShare;
+    *why = out.str();
+    return false;
+  }
   DeadReckoningOptions chain;
   chain.hold_through_gaps = true;
   std::vector<TimedPose> nodes;
   std::vector<OdometryGap> gaps;
-  std::string error;
-  if (!IntegrateOdometry({first, 0.0, 0.0, 0.0}, odometry, chain, &nodes, &gaps,
-                         &error) ||
-      nodes.size() < 2) {
+  if (!IntegrateOdometry({odometry.front().t0, 0.0, 0.0, 0.0}, odometry, chain,
+                         &nodes, &gaps, why)) {
     return false;
   }
   std::vector<double> unwound(nodes.size());
@@ -64,27 +91,6 @@ bool EstimateOdometryDiffusion(const std::vector<Odometry>& odometry,
     unwound[i] =
         unwound[i - 1] + WrapAngle(nodes[i].theta - nodes[i - 1].theta);
   }
-  // The stretches the records cover, between the gaps the chain held
-  // through.
-  std::sort(gaps.begin(), gaps.end(),
-            [](const OdometryGap& a, const OdometryGap& b) {
-              return a.begin < b.begin;
-            });
-  std::vector<std::pair<double, double>> stretches;
-  double covered = 0.0;
-  double begin = nodes.front().t;
-  for (const OdometryGap& g : gaps) {
-    stretches.push_back({begin, g.begin});
-    covered += g.begin - begin;
-    begin = g.end;
-  }
-  stretches.push_back({begin, nodes.back().t});
-  covered += nodes.back().t - begin;
-  // At most kWindowsPerRecord windows a record: a record of days among
-  // records of 0.1 s widens the windows rather than the loop.
-  const double w = std::max(
-      {kMinWindowSeconds, median,
-       covered / (kWindowsPerRecord * static_cast<double>(odometry.size()))});
   double position = 0.0, heading = 0.0;
   int windows = 0;
   for (const auto& [a, b] : stretches) {
@@ -102,15 +108,28 @@ bool EstimateOdometryDiffusion(const std::vector<Odometry>& odometry,
       ++windows;
     }
   }
-  if (windows < kMinWindows) return false;
+  if (windows < kMinWindows) {
+    out << "the odometry has " << windows << " pairs of adjacent " << w
+        << " s windows of records no longer than one, under " << kMinWindows;
+    *why = out.str();
+    return false;
+  }
   // Var(d) = 2 Q_c W / 3.
   const double to_qc = 3.0 / (2.0 * w * windows);
   diffusion->position_qc = position * to_qc;
   diffusion->heading_qc = heading * to_qc;
   diffusion->windows = windows;
   diffusion->window_seconds = w;
-  return diffusion->position_qc > 0.0 && diffusion->heading_qc > 0.0 &&
-         std::isfinite(diffusion->position_qc + diffusion->heading_qc);
+  if (!(diffusion->position_qc > 0.0 && diffusion->heading_qc > 0.0 &&
+        std::isfinite(diffusion->position_qc + diffusion->heading_qc))) {
+    out << "the odometry's second differences give Q_c "
+        << diffusion->position_qc << " (x, y), " << diffusion->heading_qc
+        << " (theta)";
+    *why = out.str();
+    *diffusion = OdometryDiffusion();
+    return false;
+  }
+  return true;
 }
 
 }  // namespace rff

@@ -6,6 +6,7 @@
 #ifndef RFF_CERES_PRIORS_ODOMETRY_DIFFUSION_H_
 #define RFF_CERES_PRIORS_ODOMETRY_DIFFUSION_H_
 
+#include <string>
 #include <vector>
 
 #include "Eigen/Core"
@@ -21,12 +22,13 @@ struct OdometryDiffusion {
 };
 
 // Estimates from the dead reckoning of `odometry` (any order): W is the
-// largest of 0.5 s, the median record's duration and a quarter of the mean
-// record's (at most four windows a record); windows fill the stretches
-// between the chain's gaps. False where fewer than 10 pairs fit or the
-// chain does not integrate.
-bool EstimateOdometryDiffusion(const std::vector<Odometry>& odometry,
-                               OdometryDiffusion* diffusion);
+// larger of 0.5 s and the median record's duration, and the windows fill
+// the stretches of records no longer than W that meet end to end. False,
+// saying why, where those records hold under half the odometry's time,
+// fewer than 10 pairs fit, the chain does not integrate, or the estimate is
+// not positive (no motion).
+bool EstimateOdometryDiffusion(std::vector<Odometry> odometry,
+                               OdometryDiffusion* diffusion, std::string* why);
 
 }  // namespace rff
 

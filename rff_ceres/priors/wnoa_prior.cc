@@ -2,6 +2,8 @@
 // a pose and velocity state at the data's times (WnoaTrajectory); its scales
 // are the diffusions Q_c of position and heading.
 #include <algorithm>
+#include <sstream>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -13,6 +15,8 @@
 
 namespace rff {
 namespace {
+
+constexpr double kMaxStartRatio = 1e6;
 
 // Every time the data constrain: the states reach both ends. Ground truth
 // only asks for outputs, which beyond the states extrapolate at constant
@@ -67,19 +71,35 @@ class WnoaPriorImpl : public TrajectoryPrior {
   // 25000 (MRCLAM) times what recordings learn, tenfold steps a round away.
   void StartLearnedScales(const Dataset& dataset, SlamOptions* options,
                           SlamResult* result) const override {
-    // An odometry whose scale is estimated says nothing of the motion's
-    // size (the scale absorbs it): Q_c learned from such a start shrank the
-    // map with the scale.
-    OdometryDiffusion diffusion;
     if (options->wnoa.qc_start != "odometry" ||
-        !options->problem.use_odometry ||
-        options->problem.odometry_calibration.estimate ||
-        !EstimateOdometryDiffusion(dataset.odometry, &diffusion)) {
+        !options->problem.use_odometry || dataset.odometry.empty()) {
       return;
     }
-    options->wnoa.position_qc = diffusion.position_qc;
-    options->wnoa.heading_qc = diffusion.heading_qc;
-    result->qc_from_odometry = diffusion;
+    std::string& why = result->qc_start_kept;
+    OdometryDiffusion d;
+    if (options->problem.odometry_calibration.estimate) {
+      // The scale absorbs what the odometry says of the motion's size: Q_c
+      // learned from such a start shrank the map with the scale.
+      why = "the odometry's scale is estimated";
+      return;
+    }
+    if (!EstimateOdometryDiffusion(dataset.odometry, &d, &why)) return;
+    // Six of the rounds' tenfold steps reach as far from the given values;
+    // beyond, the odometry barely moves (a robot standing still), and a Q_c
+    // near zero would leave the first solve no digits.
+    const double position = d.position_qc / options->wnoa.position_qc;
+    const double heading = d.heading_qc / options->wnoa.heading_qc;
+    if (std::max({position, heading, 1.0 / position, 1.0 / heading}) >
+        kMaxStartRatio) {
+      std::ostringstream out;
+      out << "the odometry's " << d.position_qc << " (x, y), " << d.heading_qc
+          << " (theta) are over " << kMaxStartRatio << " times off them";
+      why = out.str();
+      return;
+    }
+    options->wnoa.position_qc = d.position_qc;
+    options->wnoa.heading_qc = d.heading_qc;
+    result->qc_from_odometry = d;
   }
   const char* scales_name() const override { return "Q_c"; }
   std::vector<std::string> scale_flags() const override {

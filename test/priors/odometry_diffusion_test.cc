@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "costs/angle.h"
@@ -59,7 +60,8 @@ TEST(OdometryDiffusionTest, RecoversTheDrawsQc) {
     const std::vector<Odometry> odometry =
         DrawnOdometry(0.03, 0.002, 1.0, 3000.0, 0.1, seed);
     OdometryDiffusion d;
-    ASSERT_TRUE(EstimateOdometryDiffusion(odometry, &d)) << seed;
+    std::string why;
+    ASSERT_TRUE(EstimateOdometryDiffusion(odometry, &d, &why)) << why;
     EXPECT_DOUBLE_EQ(d.window_seconds, 0.5);
     EXPECT_NEAR(d.windows, 5999, 1);
     EXPECT_NEAR(d.position_qc / 0.03, 1.0, 0.05) << seed;
@@ -72,7 +74,8 @@ TEST(OdometryDiffusionTest, WindowsSpanTheMedianRecord) {
   const std::vector<Odometry> odometry =
       DrawnOdometry(0.03, 0.002, 1.0, 6000.0, 2.0, 4);
   OdometryDiffusion d;
-  ASSERT_TRUE(EstimateOdometryDiffusion(odometry, &d));
+  std::string why;
+  ASSERT_TRUE(EstimateOdometryDiffusion(odometry, &d, &why)) << why;
   EXPECT_DOUBLE_EQ(d.window_seconds, 2.0);
   EXPECT_NEAR(d.position_qc / 0.03, 1.0, 0.1);
 }
@@ -87,41 +90,91 @@ TEST(OdometryDiffusionTest, SkipsTheWindowsAGapTouches) {
     if (o.t1 <= 150.0 || o.t0 >= 200.0) with_gap.push_back(o);
   }
   OdometryDiffusion whole, gapped;
-  ASSERT_TRUE(EstimateOdometryDiffusion(odometry, &whole));
-  ASSERT_TRUE(EstimateOdometryDiffusion(with_gap, &gapped));
+  std::string why;
+  ASSERT_TRUE(EstimateOdometryDiffusion(odometry, &whole, &why)) << why;
+  ASSERT_TRUE(EstimateOdometryDiffusion(with_gap, &gapped, &why)) << why;
   EXPECT_LT(gapped.windows, whole.windows - 100);
   EXPECT_NEAR(gapped.position_qc / whole.position_qc, 1.0, 0.1);
 }
 
-TEST(OdometryDiffusionTest, ARecordOfDaysWidensTheWindows) {
-  // 100 records of 0.1 s and one of 10^9 s: at most four windows a record,
-  // not 2 10^9 windows of 0.5 s.
-  std::vector<Odometry> odometry =
-      DrawnOdometry(0.03, 0.002, 1.0, 10.0, 0.1, 8);
-  Odometry long_record = odometry.back();
+// 20 s of 0.1 s records with one of `seconds` in the middle.
+std::vector<Odometry> WithALongRecord(double seconds) {
+  const std::vector<Odometry> drawn =
+      DrawnOdometry(0.03, 0.002, 1.0, 20.0, 0.1, 8);
+  std::vector<Odometry> odometry;
+  for (Odometry o : drawn) {
+    if (o.t0 >= 10.0 - 1e-9) {
+      o.t0 += seconds;
+      o.t1 += seconds;
+    }
+    odometry.push_back(o);
+  }
+  Odometry long_record = drawn[99];
   long_record.t0 = long_record.t1;
-  long_record.t1 = long_record.t0 + 1e9;
+  long_record.t1 = long_record.t0 + seconds;
   odometry.push_back(long_record);
+  return odometry;
+}
+
+TEST(OdometryDiffusionTest, ARecordLongerThanAWindowEndsAStretch) {
+  // A straight line, whose second differences would be zero: the windows
+  // fill the 10 s on either side, 19 pairs each.
   OdometryDiffusion d;
-  ASSERT_TRUE(EstimateOdometryDiffusion(odometry, &d));
-  EXPECT_NEAR(d.window_seconds, (1e9 + 10.0) / (4.0 * 101), 1.0);
-  EXPECT_LE(d.windows, 4 * 101);
+  std::string why;
+  ASSERT_TRUE(EstimateOdometryDiffusion(WithALongRecord(10.0), &d, &why))
+      << why;
+  EXPECT_DOUBLE_EQ(d.window_seconds, 0.5);
+  EXPECT_EQ(d.windows, 38);
+  EXPECT_NEAR(d.position_qc / 0.03, 1.0, 0.5);
+  // One of 10^9 s holds nearly all the odometry's time (and would take
+  // 2 10^9 windows of 0.5 s).
+  EXPECT_FALSE(EstimateOdometryDiffusion(WithALongRecord(1e9), &d, &why));
+  EXPECT_EQ(why,
+            "the odometry's records no longer than 0.5 s cover 2e-08 of its "
+            "time, under 0.5");
+}
+
+TEST(OdometryDiffusionTest, RecordsLongerThanAWindowForMostOfTheRun) {
+  // 10 s of 0.1 s records, then 20 s of 2 s ones: the median is 0.1 s and
+  // the short records hold a third of the odometry's time.
+  std::vector<Odometry> odometry =
+      DrawnOdometry(0.03, 0.002, 1.0, 10.0, 0.1, 9);
+  for (const Odometry& o : DrawnOdometry(0.03, 0.002, 1.0, 20.0, 2.0, 9)) {
+    Odometry late = o;
+    late.t0 += 10.0;
+    late.t1 += 10.0;
+    odometry.push_back(late);
+  }
+  OdometryDiffusion d;
+  std::string why;
+  EXPECT_FALSE(EstimateOdometryDiffusion(odometry, &d, &why));
+  EXPECT_EQ(why,
+            "the odometry's records no longer than 0.5 s cover 0.333333 of "
+            "its time, under 0.5");
 }
 
 TEST(OdometryDiffusionTest, TooShortAChainEstimatesNothing) {
   OdometryDiffusion d;
-  EXPECT_FALSE(EstimateOdometryDiffusion({}, &d));
+  std::string why;
+  EXPECT_FALSE(EstimateOdometryDiffusion({}, &d, &why));
+  EXPECT_EQ(why, "the run has no odometry");
   // 5 s: 9 pairs of adjacent 0.5 s windows; 5.5 s: 10.
   EXPECT_FALSE(EstimateOdometryDiffusion(
-      DrawnOdometry(0.03, 0.002, 1.0, 5.0, 0.1, 6), &d));
+      DrawnOdometry(0.03, 0.002, 1.0, 5.0, 0.1, 6), &d, &why));
   EXPECT_EQ(d.windows, 0);
+  EXPECT_EQ(why,
+            "the odometry has 9 pairs of adjacent 0.5 s windows of records no "
+            "longer than one, under 10");
   EXPECT_TRUE(EstimateOdometryDiffusion(
-      DrawnOdometry(0.03, 0.002, 1.0, 5.5, 0.1, 6), &d));
+      DrawnOdometry(0.03, 0.002, 1.0, 5.5, 0.1, 6), &d, &why));
   EXPECT_EQ(d.windows, 10);
   // A robot standing still implies no diffusion at all.
   std::vector<Odometry> still = DrawnOdometry(0.03, 0.002, 0.0, 60.0, 0.1, 7);
   for (Odometry& o : still) o.dx = o.dy = o.dtheta = 0.0;
-  EXPECT_FALSE(EstimateOdometryDiffusion(still, &d));
+  EXPECT_FALSE(EstimateOdometryDiffusion(still, &d, &why));
+  EXPECT_EQ(why,
+            "the odometry's second differences give Q_c 0 (x, y), 0 (theta)");
+  EXPECT_EQ(d.windows, 0);
 }
 
 }  // namespace
