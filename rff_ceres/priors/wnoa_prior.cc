@@ -93,7 +93,8 @@ class WnoaPriorImpl : public TrajectoryPrior {
         kMaxStartRatio) {
       std::ostringstream out;
       out << "the odometry's " << d.position_qc << " (x, y), " << d.heading_qc
-          << " (theta) are over " << kMaxStartRatio << " times off them";
+          << " (theta) are over " << kMaxStartRatio
+          << " times off the given values";
       why = out.str();
       return;
     }

@@ -224,6 +224,21 @@ TEST(TrajectoryPriorTest, WnoaLearningStartsFromTheOdometry) {
            << start << " (x, y), " << started.qc_from_odometry.heading_qc
            << " (theta)\n";
   EXPECT_NE(out.str().find(expected.str()), std::string::npos) << out.str();
+  // A start over 10^6 times off the given Q_c is a degenerate estimate.
+  options.wnoa.position_qc = 1e5 * start;
+  SlamResult far;
+  ASSERT_TRUE(RunSlam(dataset, options, &far, &error)) << error;
+  EXPECT_EQ(far.qc_from_odometry.windows, 298);
+  EXPECT_EQ(far.qc_start_kept, "");
+  options.wnoa.position_qc = 1e7 * start;
+  ASSERT_TRUE(RunSlam(dataset, options, &far, &error)) << error;
+  EXPECT_EQ(far.qc_from_odometry.windows, 0);
+  std::ostringstream far_why;
+  far_why << "the odometry's " << start << " (x, y), "
+          << started.qc_from_odometry.heading_qc
+          << " (theta) are over 1e+06 times off the given values";
+  EXPECT_EQ(far.qc_start_kept, far_why.str());
+  options.wnoa.position_qc = WnoaOptions().position_qc;
   // Where the odometry's scale is estimated, it says nothing of the size.
   options.problem.odometry_calibration.estimate = true;
   SlamResult calibrated;
