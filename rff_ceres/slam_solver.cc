@@ -303,13 +303,16 @@ bool RunSlamAtOrigin(const Dataset& dataset, const SlamOptions& given,
   if (!ToCeresOptions(given.solver, &ceres_options, error)) return false;
   if (!ValidateSlamOptions(given, error)) return false;
   if (!CheckData(dataset, given, error)) return false;
-  // A Markov prior's learning rounds (batch solves only) start where the
-  // data put its scales.
+  // WNOA learns its Q_c and the data's noise scales (LearnScales): its
+  // prior is the only motion model besides the odometry, whose sigmas, like
+  // the sensors', are the recording's guess.
+  const TrajectoryPrior& prior = PriorOf(given);
+  const bool wnoa_learns =
+      !prior.has_features() && given.learn_hyperparameters != "off";
+  // Its rounds (batch solves only) start where the data put its scales.
   SlamOptions options = given;
-  if (!PriorOf(options).has_features() &&
-      options.learn_hyperparameters != "off" &&
-      options.incremental.every == 0) {
-    PriorOf(options).StartLearnedScales(dataset, &options, result);
+  if (wnoa_learns && options.incremental.every == 0) {
+    prior.StartLearnedScales(dataset, &options, result);
   }
   const IncrementalOptions& incremental = options.incremental;
 
@@ -360,12 +363,6 @@ bool RunSlamAtOrigin(const Dataset& dataset, const SlamOptions& given,
   const bool search =
       options.learn_hyperparameters == "on" ||
       (options.learn_hyperparameters == "auto" && dataset.odometry.empty());
-  // WNOA learns its Q_c and the data's noise scales (LearnScales): its
-  // prior is the only motion model besides the odometry, whose sigmas, like
-  // the sensors', are the recording's guess.
-  const TrajectoryPrior& prior = PriorOf(options);
-  const bool wnoa_learns =
-      !prior.has_features() && options.learn_hyperparameters != "off";
   // With a "wnoa" mean the RFF weights are a correction to a solve of the
   // same data: its variances start at what the capacity rule resolves and
   // are learned from the data (LearnScales).

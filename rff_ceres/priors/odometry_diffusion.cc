@@ -7,8 +7,8 @@
 #include <utility>
 #include <vector>
 
-#include "costs/angle.h"
 #include "rff_ceres/dead_reckoning.h"
+#include "rff_ceres/mean/mean_function.h"
 #include "rff_ceres/metrics.h"
 
 namespace rff {
@@ -17,23 +17,6 @@ namespace {
 constexpr double kMinWindowSeconds = 0.5;
 constexpr int kMinWindows = 10;
 constexpr double kMinShare = 0.5;
-
-// The chain's pose at t by linear interpolation of its nodes, heading
-// unwound (`nodes` sorted, t inside their span).
-Eigen::Vector3d PoseAt(const std::vector<TimedPose>& nodes,
-                       const std::vector<double>& unwound, double t) {
-  const auto it = std::upper_bound(
-      nodes.begin(), nodes.end(), t,
-      [](double time, const TimedPose& p) { return time < p.t; });
-  const std::size_t i1 = std::min<std::size_t>(
-      std::max<std::ptrdiff_t>(it - nodes.begin(), 1), nodes.size() - 1);
-  const std::size_t i0 = i1 - 1;
-  const double span = nodes[i1].t - nodes[i0].t;
-  const double a = span > 0.0 ? (t - nodes[i0].t) / span : 0.0;
-  return Eigen::Vector3d((1 - a) * nodes[i0].x + a * nodes[i1].x,
-                         (1 - a) * nodes[i0].y + a * nodes[i1].y,
-                         (1 - a) * unwound[i0] + a * unwound[i1]);
-}
 
 }  // namespace
 
@@ -57,9 +40,10 @@ bool EstimateOdometryDiffusion(std::vector<Odometry> odometry,
   std::vector<std::pair<double, double>> stretches;
   double recorded = 0.0, in_stretches = 0.0;
   for (const Odometry& o : odometry) {
-    recorded += o.t1 - o.t0;
-    if (o.t1 - o.t0 <= w) in_stretches += o.t1 - o.t0;
-    const bool short_record = o.t1 - o.t0 <= w;
+    const double duration = o.t1 - o.t0;
+    const bool short_record = duration <= w;
+    recorded += duration;
+    if (short_record) in_stretches += duration;
     const bool meets =
         !stretches.empty() &&
         std::abs(o.t0 - stretches.back().second) <= kTimeToleranceSeconds;
@@ -85,12 +69,8 @@ bool EstimateOdometryDiffusion(std::vector<Odometry> odometry,
                          &nodes, &gaps, why)) {
     return false;
   }
-  std::vector<double> unwound(nodes.size());
-  unwound[0] = nodes[0].theta;
-  for (std::size_t i = 1; i < nodes.size(); ++i) {
-    unwound[i] =
-        unwound[i - 1] + WrapAngle(nodes[i].theta - nodes[i - 1].theta);
-  }
+  // Linear between the nodes, the heading unwound.
+  const PiecewiseLinearMean chain_at(nodes);
   double position = 0.0, heading = 0.0;
   int windows = 0;
   for (const auto& [a, b] : stretches) {
@@ -100,8 +80,8 @@ bool EstimateOdometryDiffusion(std::vector<Odometry> odometry,
     for (double k = 0.0; k + 2.0 <= steps; k += 1.0) {
       const double t = a + k * w;
       const Eigen::Vector3d d =
-          (PoseAt(nodes, unwound, t + 2.0 * w) -
-           2.0 * PoseAt(nodes, unwound, t + w) + PoseAt(nodes, unwound, t)) /
+          (chain_at.Evaluate(t + 2.0 * w) - 2.0 * chain_at.Evaluate(t + w) +
+           chain_at.Evaluate(t)) /
           w;
       position += 0.5 * d.head<2>().squaredNorm();
       heading += d.z() * d.z();
